@@ -1,0 +1,147 @@
+//! World building: a validated scenario becomes an ECS world (resources and one entity per robot)
+//! and the tick schedule composed from the feature plugins of `systems`.
+
+use crate::scenario::{RobotConfig, Scenario};
+use crate::script::{EventQueue, fire_events};
+use bevy_ecs::prelude::*;
+use systems::body::{
+    DriveCommand, DriveState, Kinematics, Physics, PhysicsPlugin, TruePose, TrueTwist,
+};
+use systems::core::{
+    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimSet, new_schedule, stream_rng,
+};
+use systems::eval::{EvalPlugin, RobotMetrics};
+use systems::localization::{LocalizationPlugin, NavBelief, OdometryModel, WheelOdometry};
+use systems::navigation::{Behaviour, NavigationPlugin};
+use systems::sensors::{Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin};
+use systems::world::StaticWorld;
+
+/// A world ready to step.
+pub struct SimWorld {
+    pub world: World,
+    pub schedule: Schedule,
+    /// Robot entities in spawn (index) order.
+    pub robots: Vec<Entity>,
+}
+
+impl SimWorld {
+    /// One tick.
+    pub fn step(&mut self) {
+        self.schedule.run(&mut self.world);
+        self.world.resource_mut::<SimClock>().advance();
+    }
+
+    pub fn time(&self) -> f64 {
+        self.world.resource::<SimClock>().start()
+    }
+}
+
+/// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
+pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
+    let mut world = World::new();
+    let pool = KernelPool::new(threads)
+        .map_err(|e| anyhow::anyhow!("cannot start {threads} kernel threads: {e}"))?;
+    world.insert_resource(pool);
+    world.insert_resource(SimClock::new(scenario.dt));
+    let mut static_world = StaticWorld::new(scenario.grid.clone());
+    let mut physics = Physics::new(&mut static_world, scenario.dt);
+    world.insert_resource(static_world);
+
+    let mut robots = Vec::with_capacity(scenario.robots.len());
+    for (i, r) in scenario.robots.iter().enumerate() {
+        let body = physics.add_robot(i as u32, &r.start, &r.footprint);
+        let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body);
+        robots.push(e);
+    }
+    world.insert_resource(physics);
+    world.insert_resource(EventQueue::new(
+        scenario.events.clone(),
+        &scenario.robots,
+        &robots,
+    ));
+
+    let mut schedule = new_schedule();
+    schedule.add_systems(fire_events.in_set(SimSet::Script));
+    let plugins: [&dyn SimPlugin; 5] = [
+        &NavigationPlugin,
+        &PhysicsPlugin,
+        &SensorsPlugin,
+        &LocalizationPlugin,
+        &EvalPlugin,
+    ];
+    for p in plugins {
+        p.build(&mut world, &mut schedule);
+    }
+    Ok(SimWorld {
+        world,
+        schedule,
+        robots,
+    })
+}
+
+fn odometry_model(kin: &Kinematics, enc: &systems::sensors::EncoderSpec) -> OdometryModel {
+    match kin {
+        Kinematics::DiffDrive(d) => OdometryModel::DiffDrive {
+            left_radius: d.wheel_radius * (1.0 + enc.left_radius_error),
+            right_radius: d.wheel_radius * (1.0 + enc.right_radius_error),
+            wheel_base: d.wheel_base * (1.0 + enc.wheel_base_error),
+        },
+        Kinematics::Ackermann(a) => OdometryModel::Ackermann {
+            wheel_radius: a.wheel_radius * (1.0 + enc.left_radius_error),
+            wheelbase: a.wheelbase * (1.0 + enc.wheel_base_error),
+        },
+    }
+}
+
+fn spawn_robot(
+    world: &mut World,
+    seed: u64,
+    index: u32,
+    r: &RobotConfig,
+    body: systems::body::PhysicsBody,
+) -> Entity {
+    let half_width = r.footprint.bounding_radius() + 0.1;
+    let mut behaviour = Behaviour::new(
+        r.behaviour.clone(),
+        r.speed,
+        half_width,
+        stream_rng(seed, &r.name, "behaviour"),
+    );
+    behaviour.tolerance = r.tolerance;
+    let mut e = world.spawn((
+        RobotId(r.name.clone()),
+        RobotIndex(index),
+        TruePose::at(r.start),
+        TrueTwist::default(),
+        r.footprint.clone(),
+        r.kinematics.clone(),
+        DriveCommand::default(),
+        DriveState::default(),
+        body,
+        behaviour,
+        NavBelief {
+            pose: r.start,
+            stamp: 0.0,
+        },
+        RobotMetrics::default(),
+    ));
+    if let Some(spec) = &r.laser {
+        e.insert((
+            Laser::new(spec.clone(), stream_rng(seed, &r.name, "laser")),
+            LaserScans::default(),
+            LaserTruth::default(),
+        ));
+    }
+    if let Some(spec) = &r.encoder {
+        e.insert((
+            Encoder::new(spec.clone(), stream_rng(seed, &r.name, "encoder")),
+            EncoderReadings::default(),
+            WheelOdometry::new(
+                odometry_model(&r.kinematics, spec),
+                spec.ticks_per_rev,
+                r.start,
+            ),
+        ));
+    }
+    e.id()
+}

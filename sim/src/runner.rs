@@ -1,0 +1,141 @@
+//! The run loop: steps the schedule for the scenario's duration as fast as the CPU allows, shows
+//! progress (simulated time and real-time factor), records, and gathers the summary.
+
+use crate::build::{SimWorld, build_world};
+use crate::record::{RrdRecorder, record_rrd};
+use crate::scenario::Scenario;
+use crate::summary::{RobotSummary, Summary};
+use bevy_ecs::prelude::*;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::time::Instant;
+use systems::body::TruePose;
+use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
+use systems::eval::RobotMetrics;
+use systems::navigation::{Behaviour, NavStatus};
+
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Write the .rrd here (None: no recording).
+    pub rrd: Option<PathBuf>,
+    /// Kernel threads (0 = all cores).
+    pub threads: usize,
+    /// Show a progress bar.
+    pub progress: bool,
+    /// Sample every robot's true pose at this period (s) into the output (tests, analysis).
+    pub trajectory_period: Option<f64>,
+}
+
+pub struct RunOutput {
+    pub summary: Summary,
+    /// (time, true pose of each robot in index order), if requested.
+    pub trajectory: Vec<(f64, Vec<Pose2>)>,
+}
+
+fn truth_poses(w: &mut World) -> Vec<Pose2> {
+    let mut q = w.query::<(&RobotIndex, &TruePose)>();
+    let mut v: Vec<(RobotIndex, Pose2)> = q.iter(w).map(|(i, t)| (*i, t.pose)).collect();
+    v.sort_by_key(|(i, _)| *i);
+    v.into_iter().map(|(_, p)| p).collect()
+}
+
+/// Runs a scenario to its end.
+pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<RunOutput> {
+    let mut sim: SimWorld = build_world(scenario, opts.threads)?;
+    if let Some(path) = &opts.rrd {
+        let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
+        sim.world.insert_resource(rec);
+        sim.schedule.add_systems(record_rrd.in_set(SimSet::Record));
+    }
+    let ticks = (scenario.duration / scenario.dt).round().max(1.0) as u64;
+    let bar = if opts.progress {
+        let b = ProgressBar::new(ticks);
+        b.set_style(
+            ProgressStyle::with_template(
+                "{bar:40.cyan/blue} {percent:>3}%  {msg}  [{elapsed_precise} < {eta}]",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let started = Instant::now();
+    let mut trajectory = Vec::new();
+    let mut next_sample = 0.0;
+    let update_every = (ticks / 500).max(1);
+    for tick in 0..ticks {
+        if let Some(period) = opts.trajectory_period {
+            let t = sim.time();
+            if t + 1e-9 >= next_sample {
+                trajectory.push((t, truth_poses(&mut sim.world)));
+                next_sample += period;
+            }
+        }
+        sim.step();
+        if tick % update_every == 0 || tick + 1 == ticks {
+            let sim_t = (tick + 1) as f64 * scenario.dt;
+            let wall = started.elapsed().as_secs_f64().max(1e-9);
+            bar.set_position(tick + 1);
+            bar.set_message(format!(
+                "sim {sim_t:.1}/{:.1} s  {:.1}× real time",
+                scenario.duration,
+                sim_t / wall
+            ));
+        }
+    }
+    bar.finish_and_clear();
+    let wall_time_s = started.elapsed().as_secs_f64();
+    if let Some(mut rec) = sim.world.remove_resource::<RrdRecorder>() {
+        rec.finish()?;
+    }
+    if opts.trajectory_period.is_some() {
+        trajectory.push((sim.time(), truth_poses(&mut sim.world)));
+    }
+    let sim_time_s = ticks as f64 * scenario.dt;
+    let summary = Summary {
+        scenario: scenario.name.clone(),
+        seed: scenario.seed,
+        sim_time_s,
+        wall_time_s,
+        real_time_factor: sim_time_s / wall_time_s.max(1e-9),
+        robots: robot_summaries(&mut sim.world),
+    };
+    Ok(RunOutput {
+        summary,
+        trajectory,
+    })
+}
+
+fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
+    let mut q = w.query::<(&RobotIndex, &RobotId, &TruePose, &RobotMetrics, &Behaviour)>();
+    let mut rows: Vec<(RobotIndex, RobotSummary)> = q
+        .iter(w)
+        .map(|(i, id, truth, m, b)| {
+            let p = truth.pose;
+            (
+                *i,
+                RobotSummary {
+                    name: id.0.clone(),
+                    distance_m: m.distance_m,
+                    collisions: m.collisions.total(),
+                    wall_collisions: m.collisions.wall,
+                    robot_collisions: m.collisions.robot,
+                    odometry_drift_m: m.odometry_drift_m,
+                    max_odometry_drift_m: m.max_odometry_drift_m,
+                    odometry_drift_percent: if m.distance_m > 0.0 {
+                        100.0 * m.odometry_drift_m / m.distance_m
+                    } else {
+                        0.0
+                    },
+                    odometry_heading_error_rad: m.odometry_heading_error_rad,
+                    waypoints_reached: b.reached,
+                    route_completed: b.status == NavStatus::Arrived,
+                    final_pose: [p.x, p.y, p.theta],
+                },
+            )
+        })
+        .collect();
+    rows.sort_by_key(|(i, _)| *i);
+    rows.into_iter().map(|(_, r)| r).collect()
+}

@@ -1,0 +1,229 @@
+//! The scenario file as written (TOML, deserialized with serde; unknown keys are errors).
+//! Validation and defaults live in `resolve`.
+
+use serde::Deserialize;
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioFile {
+    pub name: Option<String>,
+    pub description: Option<String>,
+    pub seed: Option<u64>,
+    pub dt: Option<f64>,
+    pub duration: Option<f64>,
+    pub map: Option<MapFile>,
+    #[serde(default)]
+    pub walls: Vec<WallFile>,
+    #[serde(default)]
+    pub boxes: Vec<BoxFile>,
+    #[serde(default)]
+    pub discs: Vec<DiscFile>,
+    pub record: Option<RecordFile>,
+    #[serde(default)]
+    pub robots: Vec<RobotFile>,
+    #[serde(default)]
+    pub events: Vec<EventFile>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct MapFile {
+    /// ROS map_server YAML, relative to the scenario file.
+    pub file: Option<String>,
+    /// Named places (TOML), relative to the scenario file.
+    pub places: Option<String>,
+    /// Cell size of a world made of vector shapes only (m).
+    pub resolution: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct WallFile {
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    pub thickness: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct BoxFile {
+    pub center: [f64; 2],
+    pub size: [f64; 2],
+    pub yaw: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct DiscFile {
+    pub center: [f64; 2],
+    pub radius: f64,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RecordFile {
+    /// Robot poses per second of simulated time.
+    pub rate: Option<f64>,
+    /// Laser scans per second.
+    pub scan_rate: Option<f64>,
+    /// Driven paths per second.
+    pub path_rate: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct RobotFile {
+    pub name: String,
+    /// [x, y, yaw] (m, m, rad) or a place name.
+    pub start: PointOrPlace,
+    pub footprint: Option<FootprintFile>,
+    pub kinematics: Option<KinematicsFile>,
+    pub behaviour: Option<BehaviourFile>,
+    pub sensors: Option<SensorsFile>,
+}
+
+/// A point given as coordinates or as the name of a place.
+#[derive(Deserialize, Debug, Clone)]
+#[serde(untagged)]
+pub enum PointOrPlace {
+    Coords(Vec<f64>),
+    Place(String),
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct FootprintFile {
+    /// Radius of a round robot (m).
+    pub circle: Option<f64>,
+    /// [length, width] of a rectangular robot (m).
+    pub rectangle: Option<[f64; 2]>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum KinematicsType {
+    DiffDrive,
+    Ackermann,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct KinematicsFile {
+    #[serde(rename = "type")]
+    pub kind: KinematicsType,
+    // differential drive
+    pub wheel_base: Option<f64>,
+    pub wheel_radius: Option<f64>,
+    pub max_wheel_speed: Option<f64>,
+    pub max_wheel_accel: Option<f64>,
+    // Ackermann
+    pub wheelbase: Option<f64>,
+    pub max_steer: Option<f64>,
+    pub max_steer_rate: Option<f64>,
+    pub max_speed: Option<f64>,
+    pub max_accel: Option<f64>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum BehaviourType {
+    Idle,
+    Waypoints,
+    Wander,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct BehaviourFile {
+    #[serde(rename = "type")]
+    pub kind: BehaviourType,
+    pub points: Option<Vec<PointOrPlace>>,
+    #[serde(rename = "loop")]
+    pub looping: Option<bool>,
+    pub speed: Option<f64>,
+    pub tolerance: Option<f64>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SensorsFile {
+    pub laser: Option<LaserFile>,
+    pub encoder: Option<EncoderFile>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LaserFile {
+    pub preset: Option<String>,
+    pub fov_deg: Option<f64>,
+    pub increment_deg: Option<f64>,
+    pub min_range: Option<f64>,
+    pub max_range: Option<f64>,
+    pub rate: Option<f64>,
+    pub noise_std: Option<f64>,
+    pub dropout: Option<f64>,
+    /// [x, y, yaw] in the robot frame.
+    pub mount: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderFile {
+    pub ticks_per_rev: Option<u32>,
+    pub left_radius_error: Option<f64>,
+    pub right_radius_error: Option<f64>,
+    pub wheel_base_error: Option<f64>,
+    pub slip_std: Option<f64>,
+    pub rate: Option<f64>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum EventType {
+    Waypoints,
+    Teleport,
+    SensorFault,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorName {
+    Laser,
+    Encoder,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct EventFile {
+    /// Simulated time (s).
+    pub at: f64,
+    #[serde(rename = "type")]
+    pub kind: EventType,
+    pub robot: String,
+    // waypoints
+    pub points: Option<Vec<PointOrPlace>>,
+    #[serde(rename = "loop")]
+    pub looping: Option<bool>,
+    // teleport
+    pub pose: Option<PointOrPlace>,
+    // sensor_fault
+    pub sensor: Option<SensorName>,
+    /// true: the fault starts (sensor silent); false: it ends.
+    pub active: Option<bool>,
+}
+
+/// Named places next to a map: `[places.<name>] pose = [x, y, yaw]`.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct PlacesFile {
+    #[serde(default)]
+    pub places: std::collections::BTreeMap<String, PlaceFile>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct PlaceFile {
+    pub pose: [f64; 3],
+    pub kind: Option<String>,
+    pub description: Option<String>,
+}

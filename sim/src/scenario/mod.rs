@@ -1,0 +1,154 @@
+//! Scenario files (TOML): seed, dt, duration, the world (ROS map and/or vector shapes, named
+//! places), robots (kinematics, footprint, start pose, sensors from presets with overrides, a
+//! driving behaviour), recording rates and timed events. Unknown keys and out-of-range values are
+//! errors naming the file, line and key. The format is documented in README.md.
+
+pub mod error;
+pub mod file;
+pub mod resolve;
+
+pub use error::ScenarioError;
+pub use file::SensorName;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use systems::body::{Footprint, Kinematics};
+use systems::core::Pose2;
+use systems::navigation::BehaviourKind;
+use systems::sensors::{EncoderSpec, LaserSpec};
+use systems::world::OccupancyGrid;
+
+/// A validated scenario with every default filled in.
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    pub name: String,
+    pub description: String,
+    pub seed: u64,
+    pub dt: f64,
+    pub duration: f64,
+    /// Where it came from (for messages).
+    pub source: String,
+    pub grid: OccupancyGrid,
+    pub places: BTreeMap<String, Pose2>,
+    pub record: RecordConfig,
+    pub robots: Vec<RobotConfig>,
+    pub events: Vec<Event>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct RecordConfig {
+    /// Poses per second.
+    pub rate: f64,
+    /// Scans per second.
+    pub scan_rate: f64,
+    /// Driven paths per second.
+    pub path_rate: f64,
+}
+
+impl Default for RecordConfig {
+    fn default() -> Self {
+        RecordConfig {
+            rate: 10.0,
+            scan_rate: 5.0,
+            path_rate: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct RobotConfig {
+    pub name: String,
+    pub start: Pose2,
+    pub footprint: Footprint,
+    pub kinematics: Kinematics,
+    pub behaviour: BehaviourKind,
+    pub speed: f64,
+    pub tolerance: f64,
+    pub laser: Option<LaserSpec>,
+    pub encoder: Option<EncoderSpec>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Event {
+    pub at: f64,
+    pub robot: String,
+    pub action: EventAction,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum EventAction {
+    Waypoints {
+        points: Vec<[f64; 2]>,
+        looping: bool,
+    },
+    Teleport(Pose2),
+    SensorFault {
+        sensor: SensorName,
+        active: bool,
+    },
+}
+
+/// Loads and validates a scenario file.
+pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        file: path.display().to_string(),
+        line: None,
+        column: None,
+        key: None,
+        message: format!("cannot read: {e}"),
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scenario");
+    parse_scenario(&text, &path.display().to_string(), &base, stem)
+}
+
+/// Parses and validates scenario text; relative paths resolve against `base_dir`.
+pub fn parse_scenario(
+    text: &str,
+    file_label: &str,
+    base_dir: &Path,
+    default_name: &str,
+) -> Result<Scenario, ScenarioError> {
+    resolve::resolve(text, file_label, base_dir, default_name)
+}
+
+/// The folder of the bundled assets: `$SIM_ASSETS` or the repository's `assets/`.
+pub fn assets_dir() -> PathBuf {
+    match std::env::var_os("SIM_ASSETS") {
+        Some(p) => PathBuf::from(p),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets"),
+    }
+}
+
+/// Bundled scenarios: (name, path).
+pub fn bundled_scenarios() -> Vec<(String, PathBuf)> {
+    let dir = assets_dir().join("scenarios");
+    let mut out: Vec<(String, PathBuf)> = std::fs::read_dir(&dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .filter_map(|p| Some((p.file_stem()?.to_str()?.to_string(), p.clone())))
+        .collect();
+    out.sort();
+    out
+}
+
+/// The scenario `sim run` uses without an argument.
+pub const DEFAULT_SCENARIO: &str = "hospital_patrol";
+
+/// Resolves a scenario argument: a path, or the name of a bundled scenario.
+pub fn find_scenario(arg: &str) -> Option<PathBuf> {
+    let p = PathBuf::from(arg);
+    if p.exists() {
+        return Some(p);
+    }
+    bundled_scenarios()
+        .into_iter()
+        .find(|(name, _)| name == arg)
+        .map(|(_, p)| p)
+}

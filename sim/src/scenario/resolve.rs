@@ -1,0 +1,636 @@
+//! Validation and defaults: turns a [`ScenarioFile`] into a [`Scenario`], reporting the first
+//! problem with the file, line and key.
+
+use super::error::{ErrorContext, KeyPath, ScenarioError};
+use super::file::*;
+use super::{Event, EventAction, RecordConfig, RobotConfig, Scenario};
+use std::collections::BTreeMap;
+use std::path::Path;
+use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};
+use systems::core::Pose2;
+use systems::navigation::BehaviourKind;
+use systems::sensors::{EncoderSpec, LaserSpec};
+use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
+use systems::world::{OccupancyGrid, load_map};
+
+type R<T> = Result<T, ScenarioError>;
+
+struct Checker<'a> {
+    cx: ErrorContext<'a>,
+}
+
+impl Checker<'_> {
+    fn err<T>(&self, path: &KeyPath, msg: impl Into<String>) -> R<T> {
+        Err(self.cx.at(path, msg))
+    }
+
+    /// A finite number in [lo, hi] (either bound optional), `open_lo` excluding lo.
+    fn range(
+        &self,
+        path: &KeyPath,
+        v: f64,
+        lo: Option<f64>,
+        hi: Option<f64>,
+        open_lo: bool,
+    ) -> R<f64> {
+        let below = match lo {
+            Some(l) if open_lo => v <= l,
+            Some(l) => v < l,
+            None => false,
+        };
+        let above = hi.is_some_and(|h| v > h);
+        if !v.is_finite() || below || above {
+            let want = match (lo, hi) {
+                (Some(l), Some(h)) if open_lo => format!("a number in ({l}, {h}]"),
+                (Some(l), Some(h)) => format!("a number in [{l}, {h}]"),
+                (Some(l), None) if open_lo => format!("a number greater than {l}"),
+                (Some(l), None) => format!("a number of at least {l}"),
+                (None, Some(h)) => format!("a number of at most {h}"),
+                (None, None) => "a finite number".to_string(),
+            };
+            return self.err(path, format!("expected {want}, got {v}"));
+        }
+        Ok(v)
+    }
+
+    fn positive(&self, path: &KeyPath, v: f64) -> R<f64> {
+        self.range(path, v, Some(0.0), None, true)
+    }
+
+    fn opt_positive(&self, path: &KeyPath, v: Option<f64>, default: f64) -> R<f64> {
+        match v {
+            Some(v) => self.positive(path, v),
+            None => Ok(default),
+        }
+    }
+
+    fn finite(&self, path: &KeyPath, vals: &[f64]) -> R<()> {
+        if vals.iter().any(|v| !v.is_finite()) {
+            return self.err(path, format!("expected finite numbers, got {vals:?}"));
+        }
+        Ok(())
+    }
+}
+
+fn check_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+}
+
+pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str) -> R<Scenario> {
+    let c = Checker {
+        cx: ErrorContext::new(file_label.to_string(), text),
+    };
+    let f: ScenarioFile = toml::from_str(text).map_err(|e| c.cx.from_toml(&e))?;
+    let root = KeyPath::default();
+
+    let name = f.name.clone().unwrap_or_else(|| default_name.to_string());
+    if !check_name(&name) {
+        return c.err(
+            &root.key("name"),
+            format!("expected letters, digits, `_` or `-` (it names output files), got `{name}`"),
+        );
+    }
+    let seed = f.seed.unwrap_or(0);
+    let dt = match f.dt {
+        Some(v) => c.range(&root.key("dt"), v, Some(0.0), Some(1.0), true)?,
+        None => 0.05,
+    };
+    let Some(duration) = f.duration else {
+        return c.err(&root, "missing key `duration` (simulated seconds)");
+    };
+    let duration = c.positive(&root.key("duration"), duration)?;
+
+    // --- world
+    let map = f.map.unwrap_or_default();
+    let mpath = root.key("map");
+    let mut shapes = Vec::new();
+    for (i, w) in f.walls.iter().enumerate() {
+        let p = root.key("walls").index(i);
+        c.finite(&p.key("from"), &w.from)?;
+        c.finite(&p.key("to"), &w.to)?;
+        let thickness = c.opt_positive(&p.key("thickness"), w.thickness, 0.1)?;
+        shapes.push(Shape::Wall {
+            from: w.from,
+            to: w.to,
+            thickness,
+        });
+    }
+    for (i, b) in f.boxes.iter().enumerate() {
+        let p = root.key("boxes").index(i);
+        c.finite(&p.key("center"), &b.center)?;
+        c.positive(&p.key("size"), b.size[0].min(b.size[1]))?;
+        let yaw = b.yaw.unwrap_or(0.0);
+        c.finite(&p.key("yaw"), &[yaw])?;
+        shapes.push(Shape::Box {
+            center: b.center,
+            size: b.size,
+            yaw,
+        });
+    }
+    for (i, d) in f.discs.iter().enumerate() {
+        let p = root.key("discs").index(i);
+        c.finite(&p.key("center"), &d.center)?;
+        let radius = c.positive(&p.key("radius"), d.radius)?;
+        shapes.push(Shape::Disc {
+            center: d.center,
+            radius,
+        });
+    }
+    let mut grid: OccupancyGrid = match &map.file {
+        Some(file) => {
+            let path = base_dir.join(file);
+            load_map(&path).map_err(|e| c.cx.at(&mpath.key("file"), e.to_string()))?
+        }
+        None => {
+            let res = c.opt_positive(&mpath.key("resolution"), map.resolution, 0.05)?;
+            match grid_for_shapes(&shapes, res, 2.0) {
+                Some(g) => g,
+                None => {
+                    return c.err(
+                        &root,
+                        "the world is empty: give `map.file` (a ROS map_server YAML) or walls, boxes or discs",
+                    );
+                }
+            }
+        }
+    };
+    if map.file.is_some() && map.resolution.is_some() {
+        return c.err(
+            &mpath.key("resolution"),
+            "the resolution comes from the map file; remove this key",
+        );
+    }
+    if grid.width * grid.height > 400_000_000 {
+        return c.err(&mpath, "the map has more than 400 million cells");
+    }
+    for s in &shapes {
+        rasterize(&mut grid, s);
+    }
+
+    let mut places = BTreeMap::new();
+    if let Some(pf) = &map.places {
+        let ppath = base_dir.join(pf);
+        let ptext = std::fs::read_to_string(&ppath).map_err(|e| {
+            c.cx.at(
+                &mpath.key("places"),
+                format!("cannot read {}: {e}", ppath.display()),
+            )
+        })?;
+        let pcx = ErrorContext::new(ppath.display().to_string(), &ptext);
+        let parsed: PlacesFile = toml::from_str(&ptext).map_err(|e| pcx.from_toml(&e))?;
+        for (name, place) in parsed.places {
+            let pp = KeyPath::default().key("places").key(&name).key("pose");
+            if place.pose.iter().any(|v| !v.is_finite()) {
+                return Err(pcx.at(&pp, "expected [x, y, yaw] finite numbers"));
+            }
+            places.insert(
+                name,
+                Pose2::new(place.pose[0], place.pose[1], place.pose[2]),
+            );
+        }
+    }
+
+    let point = |path: &KeyPath, p: &PointOrPlace| -> R<Pose2> {
+        match p {
+            PointOrPlace::Coords(v) if v.len() == 2 || v.len() == 3 => {
+                c.finite(path, v)?;
+                Ok(Pose2::new(v[0], v[1], v.get(2).copied().unwrap_or(0.0)))
+            }
+            PointOrPlace::Coords(v) => c.err(
+                path,
+                format!("expected [x, y] or [x, y, yaw], got {} numbers", v.len()),
+            ),
+            PointOrPlace::Place(name) => places.get(name).copied().ok_or_else(|| {
+                let known: Vec<&str> = places.keys().map(String::as_str).collect();
+                c.cx.at(
+                    path,
+                    if known.is_empty() {
+                        format!("unknown place `{name}` (the map has no places file)")
+                    } else {
+                        format!("unknown place `{name}`; known places: {}", known.join(", "))
+                    },
+                )
+            }),
+        }
+    };
+    let inside = |path: &KeyPath, p: &Pose2| -> R<()> {
+        let b = grid.bounds();
+        if p.x < b[0] || p.y < b[1] || p.x > b[2] || p.y > b[3] {
+            return c.err(
+                path,
+                format!(
+                    "({:.3}, {:.3}) lies outside the map [{:.2}, {:.2}] × [{:.2}, {:.2}]",
+                    p.x, p.y, b[0], b[2], b[1], b[3]
+                ),
+            );
+        }
+        Ok(())
+    };
+    let points = |path: &KeyPath, pts: &Option<Vec<PointOrPlace>>| -> R<Vec<[f64; 2]>> {
+        let Some(pts) = pts else {
+            return c.err(path, "missing `points` (a list of [x, y] or place names)");
+        };
+        if pts.is_empty() {
+            return c.err(&path.key("points"), "expected at least one point");
+        }
+        let mut out = Vec::new();
+        for (i, p) in pts.iter().enumerate() {
+            let pp = path.key("points").index(i);
+            let pose = point(&pp, p)?;
+            inside(&pp, &pose)?;
+            out.push([pose.x, pose.y]);
+        }
+        Ok(out)
+    };
+
+    // --- recording
+    let rec = f.record.unwrap_or_default();
+    let rp = root.key("record");
+    let d = RecordConfig::default();
+    let record = RecordConfig {
+        rate: c.opt_positive(&rp.key("rate"), rec.rate, d.rate)?,
+        scan_rate: c.opt_positive(&rp.key("scan_rate"), rec.scan_rate, d.scan_rate)?,
+        path_rate: c.opt_positive(&rp.key("path_rate"), rec.path_rate, d.path_rate)?,
+    };
+
+    // --- robots
+    let mut robots: Vec<RobotConfig> = Vec::new();
+    for (i, r) in f.robots.iter().enumerate() {
+        let p = root.key("robots").index(i);
+        if !check_name(&r.name) {
+            return c.err(
+                &p.key("name"),
+                format!("expected letters, digits, `_` or `-`, got `{}`", r.name),
+            );
+        }
+        if robots.iter().any(|o| o.name == r.name) {
+            return c.err(&p.key("name"), format!("duplicate robot name `{}`", r.name));
+        }
+        let footprint = resolve_footprint(&c, &p.key("footprint"), r.footprint.as_ref())?;
+        let start = point(&p.key("start"), &r.start)?;
+        inside(&p.key("start"), &start)?;
+        if !grid.disc_is_clear(start.x, start.y, footprint.bounding_radius()) {
+            return c.err(
+                &p.key("start"),
+                format!(
+                    "the robot at ({:.2}, {:.2}) would overlap an obstacle (footprint radius {:.2} m)",
+                    start.x,
+                    start.y,
+                    footprint.bounding_radius()
+                ),
+            );
+        }
+        let kinematics = resolve_kinematics(&c, &p.key("kinematics"), r.kinematics.as_ref())?;
+        let bp = p.key("behaviour");
+        let (behaviour, speed, tolerance) = match &r.behaviour {
+            None => (BehaviourKind::Idle, 0.6, 0.4),
+            Some(b) => {
+                let speed = c.opt_positive(&bp.key("speed"), b.speed, 0.6)?;
+                if speed > kinematics.max_speed() + 1e-9 {
+                    return c.err(
+                        &bp.key("speed"),
+                        format!(
+                            "{speed} m/s exceeds the drive's top speed of {:.3} m/s",
+                            kinematics.max_speed()
+                        ),
+                    );
+                }
+                let tolerance = c.opt_positive(&bp.key("tolerance"), b.tolerance, 0.4)?;
+                let kind = match b.kind {
+                    BehaviourType::Idle | BehaviourType::Wander => {
+                        if b.points.is_some() {
+                            return c.err(
+                                &bp.key("points"),
+                                "only a `waypoints` behaviour takes points",
+                            );
+                        }
+                        if b.looping.is_some() {
+                            return c
+                                .err(&bp.key("loop"), "only a `waypoints` behaviour takes `loop`");
+                        }
+                        if b.kind == BehaviourType::Idle {
+                            BehaviourKind::Idle
+                        } else {
+                            BehaviourKind::Wander
+                        }
+                    }
+                    BehaviourType::Waypoints => BehaviourKind::Waypoints {
+                        points: points(&bp, &b.points)?,
+                        looping: b.looping.unwrap_or(false),
+                    },
+                };
+                (kind, speed, tolerance)
+            }
+        };
+        let sensors = r.sensors.as_ref();
+        let sp = p.key("sensors");
+        let laser = match sensors.and_then(|s| s.laser.as_ref()) {
+            Some(l) => Some(resolve_laser(&c, &sp.key("laser"), l)?),
+            None => None,
+        };
+        let encoder = match sensors.and_then(|s| s.encoder.as_ref()) {
+            Some(e) => Some(resolve_encoder(&c, &sp.key("encoder"), e)?),
+            None => None,
+        };
+        if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
+            return c.err(
+                &bp.key("type"),
+                "a `waypoints` robot navigates by its odometry: give it `[robots.sensors.encoder]`",
+            );
+        }
+        robots.push(RobotConfig {
+            name: r.name.clone(),
+            start,
+            footprint,
+            kinematics,
+            behaviour,
+            speed,
+            tolerance,
+            laser,
+            encoder,
+        });
+    }
+
+    // --- events
+    let mut events = Vec::new();
+    for (i, e) in f.events.iter().enumerate() {
+        let p = root.key("events").index(i);
+        let at = c.range(&p.key("at"), e.at, Some(0.0), Some(duration), false)?;
+        let Some(robot) = robots.iter().find(|r| r.name == e.robot) else {
+            return c.err(&p.key("robot"), format!("no robot named `{}`", e.robot));
+        };
+        let only = |key: &str, present: bool, kind: &str| -> R<()> {
+            if present {
+                return c.err(
+                    &p.key(key),
+                    format!("`{key}` does not apply to a `{kind}` event"),
+                );
+            }
+            Ok(())
+        };
+        let action = match e.kind {
+            EventType::Waypoints => {
+                only("pose", e.pose.is_some(), "waypoints")?;
+                only("sensor", e.sensor.is_some(), "waypoints")?;
+                only("active", e.active.is_some(), "waypoints")?;
+                EventAction::Waypoints {
+                    points: points(&p, &e.points)?,
+                    looping: e.looping.unwrap_or(false),
+                }
+            }
+            EventType::Teleport => {
+                only("points", e.points.is_some(), "teleport")?;
+                only("loop", e.looping.is_some(), "teleport")?;
+                only("sensor", e.sensor.is_some(), "teleport")?;
+                only("active", e.active.is_some(), "teleport")?;
+                let Some(pose) = &e.pose else {
+                    return c.err(&p, "a teleport event needs `pose` ([x, y, yaw] or a place)");
+                };
+                let pose = point(&p.key("pose"), pose)?;
+                inside(&p.key("pose"), &pose)?;
+                if !grid.disc_is_clear(pose.x, pose.y, robot.footprint.bounding_radius()) {
+                    return c.err(
+                        &p.key("pose"),
+                        "the robot would be placed inside an obstacle",
+                    );
+                }
+                EventAction::Teleport(pose)
+            }
+            EventType::SensorFault => {
+                only("points", e.points.is_some(), "sensor_fault")?;
+                only("loop", e.looping.is_some(), "sensor_fault")?;
+                only("pose", e.pose.is_some(), "sensor_fault")?;
+                let Some(sensor) = e.sensor else {
+                    return c.err(&p, "a sensor_fault event needs `sensor` (laser or encoder)");
+                };
+                let has = match sensor {
+                    SensorName::Laser => robot.laser.is_some(),
+                    SensorName::Encoder => robot.encoder.is_some(),
+                };
+                if !has {
+                    return c.err(
+                        &p.key("sensor"),
+                        format!("robot `{}` has no {sensor:?} sensor", robot.name).to_lowercase(),
+                    );
+                }
+                EventAction::SensorFault {
+                    sensor,
+                    active: e.active.unwrap_or(true),
+                }
+            }
+        };
+        events.push(Event {
+            at,
+            robot: e.robot.clone(),
+            action,
+        });
+    }
+    // stable: events at the same time fire in file order
+    events.sort_by(|a, b| a.at.total_cmp(&b.at));
+
+    Ok(Scenario {
+        name,
+        description: f.description.unwrap_or_default(),
+        seed,
+        dt,
+        duration,
+        source: file_label.to_string(),
+        grid,
+        places,
+        record,
+        robots,
+        events,
+    })
+}
+
+fn resolve_footprint(c: &Checker, p: &KeyPath, f: Option<&FootprintFile>) -> R<Footprint> {
+    match f {
+        None => Ok(Footprint::Circle { radius: 0.25 }),
+        Some(FootprintFile {
+            circle: Some(r),
+            rectangle: None,
+        }) => Ok(Footprint::Circle {
+            radius: c.range(&p.key("circle"), *r, Some(0.0), Some(10.0), true)?,
+        }),
+        Some(FootprintFile {
+            circle: None,
+            rectangle: Some([l, w]),
+        }) => {
+            c.range(&p.key("rectangle"), l.min(*w), Some(0.0), None, true)?;
+            c.range(&p.key("rectangle"), l.max(*w), None, Some(20.0), false)?;
+            Ok(Footprint::Rectangle {
+                length: *l,
+                width: *w,
+            })
+        }
+        Some(_) => c.err(
+            p,
+            "expected exactly one of `circle = radius` or `rectangle = [length, width]`",
+        ),
+    }
+}
+
+fn resolve_kinematics(c: &Checker, p: &KeyPath, k: Option<&KinematicsFile>) -> R<Kinematics> {
+    let Some(k) = k else {
+        return Ok(Kinematics::DiffDrive(default_diff_drive()));
+    };
+    let not_for = |key: &str, v: Option<f64>, kind: &str| -> R<()> {
+        if v.is_some() {
+            return c.err(
+                &p.key(key),
+                format!("`{key}` does not apply to `{kind}` kinematics"),
+            );
+        }
+        Ok(())
+    };
+    match k.kind {
+        KinematicsType::DiffDrive => {
+            not_for("wheelbase", k.wheelbase, "diff_drive")?;
+            not_for("max_steer", k.max_steer, "diff_drive")?;
+            not_for("max_steer_rate", k.max_steer_rate, "diff_drive")?;
+            not_for("max_speed", k.max_speed, "diff_drive")?;
+            not_for("max_accel", k.max_accel, "diff_drive")?;
+            let d = default_diff_drive();
+            Ok(Kinematics::DiffDrive(DiffDrive {
+                wheel_base: c.opt_positive(&p.key("wheel_base"), k.wheel_base, d.wheel_base)?,
+                wheel_radius: c.opt_positive(
+                    &p.key("wheel_radius"),
+                    k.wheel_radius,
+                    d.wheel_radius,
+                )?,
+                max_wheel_speed: c.opt_positive(
+                    &p.key("max_wheel_speed"),
+                    k.max_wheel_speed,
+                    d.max_wheel_speed,
+                )?,
+                max_wheel_accel: c.opt_positive(
+                    &p.key("max_wheel_accel"),
+                    k.max_wheel_accel,
+                    d.max_wheel_accel,
+                )?,
+            }))
+        }
+        KinematicsType::Ackermann => {
+            not_for("wheel_base", k.wheel_base, "ackermann (use `wheelbase`)")?;
+            not_for("max_wheel_speed", k.max_wheel_speed, "ackermann")?;
+            not_for("max_wheel_accel", k.max_wheel_accel, "ackermann")?;
+            let max_steer = match k.max_steer {
+                Some(v) => c.range(&p.key("max_steer"), v, Some(0.0), Some(1.4), true)?,
+                None => 0.45,
+            };
+            Ok(Kinematics::Ackermann(Ackermann {
+                wheelbase: c.opt_positive(&p.key("wheelbase"), k.wheelbase, 0.35)?,
+                max_steer,
+                max_steer_rate: c.opt_positive(&p.key("max_steer_rate"), k.max_steer_rate, 1.5)?,
+                max_speed: c.opt_positive(&p.key("max_speed"), k.max_speed, 1.5)?,
+                max_accel: c.opt_positive(&p.key("max_accel"), k.max_accel, 1.0)?,
+                wheel_radius: c.opt_positive(&p.key("wheel_radius"), k.wheel_radius, 0.05)?,
+            }))
+        }
+    }
+}
+
+/// A hospital delivery robot: 0.45 m wheel base, 10 cm wheels, 1.5 m/s, 2 m/s².
+pub fn default_diff_drive() -> DiffDrive {
+    DiffDrive {
+        wheel_base: 0.45,
+        wheel_radius: 0.1,
+        max_wheel_speed: 15.0,
+        max_wheel_accel: 20.0,
+    }
+}
+
+fn resolve_laser(c: &Checker, p: &KeyPath, l: &LaserFile) -> R<LaserSpec> {
+    let preset = l.preset.as_deref().unwrap_or("sick_lms100");
+    let Some(mut s) = LaserSpec::preset(preset) else {
+        return c.err(
+            &p.key("preset"),
+            format!(
+                "unknown laser preset `{preset}`; known: {}",
+                LaserSpec::PRESETS.join(", ")
+            ),
+        );
+    };
+    if let Some(v) = l.fov_deg {
+        s.fov = c
+            .range(&p.key("fov_deg"), v, Some(0.0), Some(360.0), true)?
+            .to_radians();
+    }
+    if let Some(v) = l.increment_deg {
+        s.increment = c
+            .range(&p.key("increment_deg"), v, Some(0.0), Some(90.0), true)?
+            .to_radians();
+    }
+    if s.beams() > 20_000 {
+        return c.err(
+            &p.key("increment_deg"),
+            format!("{} beams per scan is more than 20000", s.beams()),
+        );
+    }
+    if let Some(v) = l.min_range {
+        s.min_range = c.range(&p.key("min_range"), v, Some(0.0), None, false)?;
+    }
+    if let Some(v) = l.max_range {
+        s.max_range = c.range(&p.key("max_range"), v, Some(0.0), Some(1000.0), true)?;
+    }
+    if s.min_range >= s.max_range {
+        let key = if l.min_range.is_some() {
+            "min_range"
+        } else {
+            "max_range"
+        };
+        return c.err(
+            &p.key(key),
+            format!(
+                "min_range ({}) must be below max_range ({})",
+                s.min_range, s.max_range
+            ),
+        );
+    }
+    if let Some(v) = l.rate {
+        s.rate = c.range(&p.key("rate"), v, Some(0.0), Some(1000.0), true)?;
+    }
+    if let Some(v) = l.noise_std {
+        s.noise_std = c.range(&p.key("noise_std"), v, Some(0.0), Some(10.0), false)?;
+    }
+    if let Some(v) = l.dropout {
+        s.dropout = c.range(&p.key("dropout"), v, Some(0.0), Some(1.0), false)?;
+    }
+    if let Some(m) = l.mount {
+        c.finite(&p.key("mount"), &m)?;
+        s.mount = Pose2::new(m[0], m[1], m[2]);
+    }
+    Ok(s)
+}
+
+fn resolve_encoder(c: &Checker, p: &KeyPath, e: &EncoderFile) -> R<EncoderSpec> {
+    let mut s = EncoderSpec::default();
+    if let Some(t) = e.ticks_per_rev {
+        if t == 0 {
+            return c.err(
+                &p.key("ticks_per_rev"),
+                "expected at least 1 tick per revolution",
+            );
+        }
+        s.ticks_per_rev = t;
+    }
+    let rel = |key: &str, v: Option<f64>| -> R<f64> {
+        match v {
+            Some(v) => c.range(&p.key(key), v, Some(-0.5), Some(0.5), false),
+            None => Ok(0.0),
+        }
+    };
+    s.left_radius_error = rel("left_radius_error", e.left_radius_error)?;
+    s.right_radius_error = rel("right_radius_error", e.right_radius_error)?;
+    s.wheel_base_error = rel("wheel_base_error", e.wheel_base_error)?;
+    if let Some(v) = e.slip_std {
+        s.slip_std = c.range(&p.key("slip_std"), v, Some(0.0), Some(1.0), false)?;
+    }
+    if let Some(v) = e.rate {
+        s.rate = c.range(&p.key("rate"), v, Some(0.0), Some(10_000.0), true)?;
+    }
+    Ok(s)
+}

@@ -1,0 +1,238 @@
+//! Drive kinematics. Commands are body velocities (v, ω); each model turns them into actuator
+//! states under its limits and back into the body twist actually driven, and poses advance along
+//! exact circular arcs (the closed form of constant (v, ω) over a step).
+
+use crate::core::Pose2;
+use bevy_ecs::prelude::Component;
+
+/// Differential drive: two wheels on a common axle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiffDrive {
+    /// Distance between the wheel contact points (m).
+    pub wheel_base: f64,
+    pub wheel_radius: f64,
+    /// Wheel speed limit (rad/s).
+    pub max_wheel_speed: f64,
+    /// Wheel acceleration limit (rad/s²).
+    pub max_wheel_accel: f64,
+}
+
+/// Ackermann (car-like) steering: bicycle model, no turning on the spot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ackermann {
+    /// Front-to-rear axle distance (m).
+    pub wheelbase: f64,
+    /// Steering angle limit (rad).
+    pub max_steer: f64,
+    /// Steering rate limit (rad/s).
+    pub max_steer_rate: f64,
+    pub max_speed: f64,
+    pub max_accel: f64,
+    /// Drive wheel radius (for the drive-shaft encoder).
+    pub wheel_radius: f64,
+}
+
+#[derive(Component, Clone, Debug, PartialEq)]
+pub enum Kinematics {
+    DiffDrive(DiffDrive),
+    Ackermann(Ackermann),
+}
+
+/// Desired body velocities, written by controllers.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct DriveCommand {
+    /// Forward speed (m/s).
+    pub v: f64,
+    /// Yaw rate (rad/s).
+    pub w: f64,
+}
+
+/// Actuator state, advanced by the physics step.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct DriveState {
+    /// Wheel speeds (rad/s) of a differential drive.
+    pub left: f64,
+    pub right: f64,
+    /// Forward speed (m/s) and steering angle (rad) of an Ackermann drive.
+    pub speed: f64,
+    pub steer: f64,
+}
+
+fn approach(current: f64, target: f64, max_delta: f64) -> f64 {
+    current + (target - current).clamp(-max_delta, max_delta)
+}
+
+impl DiffDrive {
+    /// Wheel speeds for (v, ω), scaled down together if one exceeds the limit (keeps curvature).
+    pub fn wheel_targets(&self, cmd: &DriveCommand) -> (f64, f64) {
+        let half = self.wheel_base / 2.0;
+        let l = (cmd.v - cmd.w * half) / self.wheel_radius;
+        let r = (cmd.v + cmd.w * half) / self.wheel_radius;
+        let m = l.abs().max(r.abs());
+        if m > self.max_wheel_speed && m > 0.0 {
+            let s = self.max_wheel_speed / m;
+            (l * s, r * s)
+        } else {
+            (l, r)
+        }
+    }
+
+    /// Body twist (v, ω) of wheel speeds.
+    pub fn twist(&self, left: f64, right: f64) -> (f64, f64) {
+        let v = self.wheel_radius * (left + right) / 2.0;
+        let w = self.wheel_radius * (right - left) / self.wheel_base;
+        (v, w)
+    }
+}
+
+impl Ackermann {
+    /// Steering angle giving yaw rate ω at speed v; none at standstill (no turning on the spot).
+    pub fn steer_for(&self, v: f64, w: f64) -> Option<f64> {
+        if v.abs() < 1e-6 {
+            return None;
+        }
+        Some(
+            (w * self.wheelbase / v)
+                .atan()
+                .clamp(-self.max_steer, self.max_steer),
+        )
+    }
+
+    pub fn yaw_rate(&self, speed: f64, steer: f64) -> f64 {
+        speed * steer.tan() / self.wheelbase
+    }
+}
+
+impl Kinematics {
+    /// Advances the actuator state towards the command over `dt` under the limits and returns the
+    /// body twist (v, ω) driven during the step.
+    pub fn step(&self, cmd: &DriveCommand, state: &mut DriveState, dt: f64) -> (f64, f64) {
+        match self {
+            Kinematics::DiffDrive(d) => {
+                let (tl, tr) = d.wheel_targets(cmd);
+                let dmax = d.max_wheel_accel * dt;
+                state.left = approach(state.left, tl, dmax);
+                state.right = approach(state.right, tr, dmax);
+                d.twist(state.left, state.right)
+            }
+            Kinematics::Ackermann(a) => {
+                let target_v = cmd.v.clamp(-a.max_speed, a.max_speed);
+                state.speed = approach(state.speed, target_v, a.max_accel * dt);
+                if let Some(target_steer) = a.steer_for(cmd.v, cmd.w) {
+                    state.steer = approach(state.steer, target_steer, a.max_steer_rate * dt);
+                }
+                (state.speed, a.yaw_rate(state.speed, state.steer))
+            }
+        }
+    }
+
+    /// Fastest forward speed the drive can reach (m/s).
+    pub fn max_speed(&self) -> f64 {
+        match self {
+            Kinematics::DiffDrive(d) => d.max_wheel_speed * d.wheel_radius,
+            Kinematics::Ackermann(a) => a.max_speed,
+        }
+    }
+}
+
+/// The pose after moving with constant (v, ω) for `dt` from `pose`: an exact circular arc
+/// (a straight line when ω = 0).
+pub fn integrate_arc(pose: &Pose2, v: f64, w: f64, dt: f64) -> Pose2 {
+    let dth = w * dt;
+    let (dx, dy) = if dth.abs() < 1e-9 {
+        // second-order expansion avoids 0/0
+        (v * dt * (1.0 - dth * dth / 6.0), v * dt * dth / 2.0)
+    } else {
+        (v / w * dth.sin(), v / w * (1.0 - dth.cos()))
+    };
+    pose.compose(&Pose2::new(dx, dy, dth))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    #[test]
+    fn arc_closes_a_circle() {
+        // v = 1 m/s, ω = 0.5 rad/s → radius 2 m, full circle in 4π s
+        let mut p = Pose2::new(1.0, 2.0, 0.3);
+        let n = 1000;
+        let dt = 4.0 * PI / n as f64;
+        let mut max_dev: f64 = 0.0;
+        let centre = p.transform_point([0.0, 2.0]);
+        for _ in 0..n {
+            p = integrate_arc(&p, 1.0, 0.5, dt);
+            max_dev = max_dev.max(((p.x - centre[0]).hypot(p.y - centre[1]) - 2.0).abs());
+        }
+        assert!(max_dev < 1e-9, "{max_dev}");
+        assert!((p.x - 1.0).abs() < 1e-9 && (p.y - 2.0).abs() < 1e-9);
+        // quarter circle: from heading 0 at origin, ends at (2, 2) heading π/2
+        let q = integrate_arc(&Pose2::IDENTITY, 1.0, 0.5, PI);
+        assert!((q.x - 2.0).abs() < 1e-12 && (q.y - 2.0).abs() < 1e-12);
+        assert!((q.theta - PI / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn diff_drive_limits_keep_curvature() {
+        let d = DiffDrive {
+            wheel_base: 0.5,
+            wheel_radius: 0.1,
+            max_wheel_speed: 10.0,
+            max_wheel_accel: 1000.0,
+        };
+        let cmd = DriveCommand { v: 2.0, w: 2.0 };
+        let (l, r) = d.wheel_targets(&cmd);
+        assert!(r <= 10.0 + 1e-12 && l > 0.0);
+        let (v, w) = d.twist(l, r);
+        assert!((w / v - 1.0).abs() < 1e-12, "curvature kept");
+        // spin in place is allowed
+        let (v, w) = d.twist(-5.0, 5.0);
+        assert_eq!(v, 0.0);
+        assert!((w - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn acceleration_is_limited() {
+        let k = Kinematics::DiffDrive(DiffDrive {
+            wheel_base: 0.5,
+            wheel_radius: 0.1,
+            max_wheel_speed: 20.0,
+            max_wheel_accel: 10.0,
+        });
+        let mut s = DriveState::default();
+        let cmd = DriveCommand { v: 1.0, w: 0.0 };
+        let (v, _) = k.step(&cmd, &mut s, 0.1);
+        assert!((v - 0.1).abs() < 1e-12); // 10 rad/s² · 0.1 s · 0.1 m
+        for _ in 0..20 {
+            k.step(&cmd, &mut s, 0.1);
+        }
+        let (v, _) = k.step(&cmd, &mut s, 0.1);
+        assert!((v - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn ackermann_cannot_turn_on_the_spot() {
+        let k = Kinematics::Ackermann(Ackermann {
+            wheelbase: 0.35,
+            max_steer: 0.5,
+            max_steer_rate: 1.0,
+            max_speed: 2.0,
+            max_accel: 100.0,
+            wheel_radius: 0.05,
+        });
+        let mut s = DriveState::default();
+        let (v, w) = k.step(&DriveCommand { v: 0.0, w: 1.0 }, &mut s, 0.1);
+        assert_eq!((v, w), (0.0, 0.0));
+        // steering is rate limited and clamped
+        let mut s = DriveState::default();
+        k.step(&DriveCommand { v: 1.0, w: 10.0 }, &mut s, 0.1);
+        assert!((s.steer - 0.1).abs() < 1e-12);
+        for _ in 0..20 {
+            k.step(&DriveCommand { v: 1.0, w: 10.0 }, &mut s, 0.1);
+        }
+        assert!((s.steer - 0.5).abs() < 1e-12);
+        let (v, w) = k.step(&DriveCommand { v: 1.0, w: 10.0 }, &mut s, 0.1);
+        assert!((w - v * 0.5f64.tan() / 0.35).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,10 @@
+//! Robot bodies: kinematics (differential drive, Ackermann), footprints and the rapier2d bridge
+//! that turns drive commands into ground-truth motion with contacts.
+
+pub mod footprint;
+pub mod kinematics;
+pub mod physics;
+
+pub use footprint::Footprint;
+pub use kinematics::{Ackermann, DiffDrive, DriveCommand, DriveState, Kinematics};
+pub use physics::{Collisions, Physics, PhysicsBody, PhysicsPlugin, TruePose, TrueTwist};

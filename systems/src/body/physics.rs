@@ -1,0 +1,314 @@
+//! The rapier2d bridge. Robots are dynamic bodies whose velocity is set every step so that,
+//! without contacts, they land exactly on the closed-form arc of their drive twist; rapier resolves
+//! robot–wall and robot–robot contacts (with CCD, so a fast robot cannot tunnel through a thin
+//! wall). Static geometry is one standalone collider per rectangle of a greedy decomposition of
+//! each 64-cell tile, so an edit rebuilds only its tile.
+//!
+//! Collisions are counted as contact STARTS: a robot that touches the wall and slides along it
+//! (across several tile colliders) counts once, until it is free of every wall again.
+
+use super::footprint::Footprint;
+use super::kinematics::{DriveCommand, DriveState, Kinematics, integrate_arc};
+use crate::core::{Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
+use crate::world::{StaticWorld, rects::tile_rects};
+use bevy_ecs::prelude::*;
+use rapier2d::prelude::*;
+use std::sync::Mutex;
+
+/// Ground-truth pose (never read by estimators, planners or controllers). `prev` is the pose at
+/// the start of the current tick, so sensors firing between ticks can interpolate.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct TruePose {
+    pub pose: Pose2,
+    pub prev: Pose2,
+}
+
+impl TruePose {
+    pub fn at(pose: Pose2) -> Self {
+        TruePose { pose, prev: pose }
+    }
+
+    /// Pose at fraction `f` ∈ [0, 1] of the current tick.
+    pub fn interpolate(&self, f: f64) -> Pose2 {
+        self.prev.lerp(&self.pose, f)
+    }
+}
+
+/// Ground-truth body twist over the last tick (m/s, rad/s).
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct TrueTwist {
+    pub v: f64,
+    pub w: f64,
+}
+
+#[derive(Component, Clone, Copy, Debug)]
+pub struct PhysicsBody(pub RigidBodyHandle);
+
+/// Contact starts of one robot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Collisions {
+    pub wall: u32,
+    pub robot: u32,
+}
+
+impl Collisions {
+    pub fn total(&self) -> u32 {
+        self.wall + self.robot
+    }
+}
+
+#[derive(Default)]
+struct EventBuffer(Mutex<Vec<CollisionEvent>>);
+
+impl EventHandler for EventBuffer {
+    fn handle_collision_event(
+        &self,
+        _bodies: &RigidBodySet,
+        _colliders: &ColliderSet,
+        event: CollisionEvent,
+        _contact_pair: Option<&ContactPair>,
+    ) {
+        if let Ok(mut v) = self.0.lock() {
+            v.push(event);
+        }
+    }
+
+    fn handle_contact_force_event(
+        &self,
+        _dt: Real,
+        _bodies: &RigidBodySet,
+        _colliders: &ColliderSet,
+        _contact_pair: &ContactPair,
+        _total_force_magnitude: Real,
+    ) {
+    }
+
+    fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
+}
+
+/// Robots' colliders carry `robot index + 1` as user data; static colliders carry 0.
+const STATIC_USER_DATA: u128 = 0;
+
+#[derive(Resource)]
+pub struct Physics {
+    pub world: PhysicsWorld,
+    tile_colliders: Vec<Vec<ColliderHandle>>,
+    tiles_x: usize,
+    events: EventBuffer,
+    wall_touching: Vec<u32>,
+    collisions: Vec<Collisions>,
+}
+
+impl Physics {
+    /// A physics world with the static colliders of `world` and timestep `dt`.
+    pub fn new(world: &mut StaticWorld, dt: f64) -> Self {
+        let mut pw = PhysicsWorld::new();
+        pw.gravity = Vector::ZERO;
+        pw.integration_parameters.dt = dt as Real;
+        let (tx, ty) = world.tile_counts();
+        let mut physics = Physics {
+            world: pw,
+            tile_colliders: vec![Vec::new(); tx * ty],
+            tiles_x: tx,
+            events: EventBuffer::default(),
+            wall_touching: Vec::new(),
+            collisions: Vec::new(),
+        };
+        world.take_dirty_tiles();
+        for y in 0..ty {
+            for x in 0..tx {
+                physics.rebuild_tile(world, x, y);
+            }
+        }
+        physics
+    }
+
+    /// Number of static colliders.
+    pub fn static_collider_count(&self) -> usize {
+        self.tile_colliders.iter().map(Vec::len).sum()
+    }
+
+    fn rebuild_tile(&mut self, world: &StaticWorld, tx: usize, ty: usize) {
+        let slot = ty * self.tiles_x + tx;
+        for h in std::mem::take(&mut self.tile_colliders[slot]) {
+            self.world.remove_collider(h);
+        }
+        let grid = world.grid();
+        for rect in tile_rects(grid, tx, ty, crate::world::COLLIDER_TILE) {
+            let (c, h) = rect.world_box(grid);
+            let collider = ColliderBuilder::cuboid(h[0] as Real, h[1] as Real)
+                .translation(Vector::new(c[0] as Real, c[1] as Real))
+                .friction(0.0)
+                .user_data(STATIC_USER_DATA)
+                .build();
+            let handle = self.world.insert_collider(collider, None);
+            self.tile_colliders[slot].push(handle);
+        }
+    }
+
+    /// Adds robot number `index` (spawn order, dense from 0) as a dynamic body.
+    pub fn add_robot(&mut self, index: u32, pose: &Pose2, footprint: &Footprint) -> PhysicsBody {
+        let body = RigidBodyBuilder::dynamic()
+            .pose(Pose2d::new(
+                Vector::new(pose.x as Real, pose.y as Real),
+                pose.theta as Real,
+            ))
+            .ccd_enabled(true)
+            .can_sleep(false)
+            .build();
+        let shape = match footprint {
+            Footprint::Circle { radius } => ColliderBuilder::ball(*radius as Real),
+            Footprint::Rectangle { length, width } => {
+                ColliderBuilder::cuboid((*length / 2.0) as Real, (*width / 2.0) as Real)
+            }
+        };
+        let collider = shape
+            .density(200.0)
+            .friction(0.0)
+            .active_events(ActiveEvents::COLLISION_EVENTS)
+            .user_data(index as u128 + 1)
+            .build();
+        let (handle, _) = self.world.insert(body, collider);
+        let n = index as usize + 1;
+        if self.collisions.len() < n {
+            self.collisions.resize(n, Collisions::default());
+            self.wall_touching.resize(n, 0);
+        }
+        PhysicsBody(handle)
+    }
+
+    /// Moves a body instantly (kidnapping), stopping it.
+    pub fn teleport(&mut self, body: PhysicsBody, pose: &Pose2) {
+        if let Some(b) = self.world.bodies.get_mut(body.0) {
+            b.set_position(
+                Pose2d::new(
+                    Vector::new(pose.x as Real, pose.y as Real),
+                    pose.theta as Real,
+                ),
+                true,
+            );
+            b.set_linvel(Vector::ZERO, true);
+            b.set_angvel(0.0, true);
+        }
+    }
+
+    pub fn collisions(&self, index: u32) -> Collisions {
+        self.collisions
+            .get(index as usize)
+            .copied()
+            .unwrap_or_default()
+    }
+
+    fn robot_of(&self, h: ColliderHandle) -> Option<u32> {
+        let data = self.world.colliders.get(h).map(|c| c.user_data)?;
+        (data != STATIC_USER_DATA).then(|| (data - 1) as u32)
+    }
+
+    /// Turns this step's collision events into contact-start counts.
+    fn count_events(&mut self) {
+        let events = match self.events.0.lock() {
+            Ok(mut v) => std::mem::take(&mut *v),
+            Err(_) => return,
+        };
+        for e in events {
+            let (h1, h2, started) = match e {
+                CollisionEvent::Started(a, b, _) => (a, b, true),
+                CollisionEvent::Stopped(a, b, _) => (a, b, false),
+            };
+            match (self.robot_of(h1), self.robot_of(h2)) {
+                (Some(a), Some(b)) => {
+                    if started {
+                        self.collisions[a as usize].robot += 1;
+                        self.collisions[b as usize].robot += 1;
+                    }
+                }
+                (Some(r), None) | (None, Some(r)) => {
+                    let t = &mut self.wall_touching[r as usize];
+                    if started {
+                        if *t == 0 {
+                            self.collisions[r as usize].wall += 1;
+                        }
+                        *t += 1;
+                    } else {
+                        *t = t.saturating_sub(1);
+                    }
+                }
+                (None, None) => {}
+            }
+        }
+    }
+}
+
+/// rapier's 2-D pose type.
+type Pose2d = rapier2d::math::Pose;
+
+/// Physics: drive every robot along its commanded arc, resolve contacts, read back ground truth.
+#[allow(clippy::type_complexity)]
+pub fn physics_step(
+    mut physics: ResMut<Physics>,
+    mut world: ResMut<StaticWorld>,
+    clock: Res<SimClock>,
+    mut robots: Query<(
+        &PhysicsBody,
+        &Kinematics,
+        &DriveCommand,
+        &mut DriveState,
+        &mut TruePose,
+        &mut TrueTwist,
+    )>,
+) {
+    let dirty = world.take_dirty_tiles();
+    for (tx, ty) in dirty {
+        physics.rebuild_tile(&world, tx, ty);
+    }
+    let dt = clock.dt;
+    for (body, kin, cmd, mut state, mut truth, _) in robots.iter_mut() {
+        let (v, w) = kin.step(cmd, &mut state, dt);
+        let current = match physics.world.bodies.get(body.0) {
+            Some(b) => {
+                let t = b.translation();
+                Pose2::new(t.x as f64, t.y as f64, b.rotation().angle() as f64)
+            }
+            None => truth.pose,
+        };
+        truth.prev = current;
+        let target = integrate_arc(&current, v, w, dt);
+        if let Some(b) = physics.world.bodies.get_mut(body.0) {
+            b.set_linvel(
+                Vector::new(
+                    ((target.x - current.x) / dt) as Real,
+                    ((target.y - current.y) / dt) as Real,
+                ),
+                true,
+            );
+            b.set_angvel((w) as Real, true);
+        }
+    }
+    let events = std::mem::take(&mut physics.events);
+    physics.world.step_with_events(&(), &events);
+    physics.events = events;
+    physics.count_events();
+    for (body, _, _, _, mut truth, mut twist) in robots.iter_mut() {
+        if let Some(b) = physics.world.bodies.get(body.0) {
+            let t = b.translation();
+            let pose = Pose2::new(t.x as f64, t.y as f64, b.rotation().angle() as f64);
+            let d = truth.prev.between(&pose);
+            twist.v = d.x / dt;
+            twist.w = wrap_angle(pose.theta - truth.prev.theta) / dt;
+            truth.pose = pose;
+        }
+    }
+}
+
+pub struct PhysicsPlugin;
+
+impl SimPlugin for PhysicsPlugin {
+    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
+        schedule.add_systems(physics_step.in_set(SimSet::Physics));
+    }
+}
+
+/// A robot's index, for looking up its collision counters.
+pub fn collisions_of(physics: &Physics, index: &RobotIndex) -> Collisions {
+    physics.collisions(index.0)
+}

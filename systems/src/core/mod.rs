@@ -1,0 +1,16 @@
+//! Components and resources every system shares: poses, the simulation clock, per-entity random
+//! streams, robot identity, the tick schedule and the kernel thread pool.
+
+pub mod clock;
+pub mod ids;
+pub mod pool;
+pub mod pose;
+pub mod rng;
+pub mod schedule;
+
+pub use clock::SimClock;
+pub use ids::{RobotId, RobotIndex};
+pub use pool::KernelPool;
+pub use pose::{Pose2, wrap_angle};
+pub use rng::{SimRng, stream_rng, stream_seed};
+pub use schedule::{SimPlugin, SimSet, new_schedule};

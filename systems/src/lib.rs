@@ -1,0 +1,16 @@
+//! The simulator's ECS vocabulary and every system, layered bottom-up:
+//! `core` ← `world` ← `raycast`/`body` ← `sensors` ← `localization` ← `navigation`/`eval`.
+//! Nothing lower imports anything higher (see ../shared/DESIGN.md).
+//!
+//! Each feature folder exposes one [`core::schedule::SimPlugin`] that adds its systems to the
+//! right [`core::schedule::SimSet`]; the `sim` crate composes them from a scenario.
+
+pub mod body;
+pub mod core;
+pub mod eval;
+pub mod localization;
+pub mod navigation;
+#[path = "raycast_stub.rs"]
+pub mod raycast;
+pub mod sensors;
+pub mod world;

@@ -1,0 +1,142 @@
+//! Wheel odometry: integrates encoder tick increments with the geometry the robot BELIEVES it
+//! has (nominal wheel radii and wheel base times the calibration errors), along circular arcs.
+//! Differential drive: ds = (ds_l + ds_r)/2, dθ = (ds_r − ds_l)/b; Ackermann: ds from the drive
+//! shaft, dθ = ds·tan(steer)/L.
+
+use crate::core::Pose2;
+use crate::sensors::EncoderReadings;
+use bevy_ecs::prelude::*;
+use std::f64::consts::TAU;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum OdometryModel {
+    DiffDrive {
+        left_radius: f64,
+        right_radius: f64,
+        wheel_base: f64,
+    },
+    Ackermann {
+        wheel_radius: f64,
+        wheelbase: f64,
+    },
+}
+
+/// The odometry estimate (frame `odom`, which coincides with `map` at the start pose).
+#[derive(Component, Clone, Debug)]
+pub struct WheelOdometry {
+    pub model: OdometryModel,
+    pub ticks_per_rev: u32,
+    pub pose: Pose2,
+    pub stamp: f64,
+    last: Option<(i64, i64)>,
+}
+
+impl WheelOdometry {
+    pub fn new(model: OdometryModel, ticks_per_rev: u32, start: Pose2) -> Self {
+        WheelOdometry {
+            model,
+            ticks_per_rev,
+            pose: start,
+            stamp: 0.0,
+            last: None,
+        }
+    }
+
+    /// Consumes one reading.
+    pub fn update(&mut self, left_ticks: i64, right_ticks: i64, steer: f64, stamp: f64) {
+        let Some((l0, r0)) = self.last.replace((left_ticks, right_ticks)) else {
+            self.stamp = stamp;
+            return;
+        };
+        let k = TAU / self.ticks_per_rev as f64;
+        let dl = (left_ticks - l0) as f64 * k;
+        let dr = (right_ticks - r0) as f64 * k;
+        let (ds, dth) = match self.model {
+            OdometryModel::DiffDrive {
+                left_radius,
+                right_radius,
+                wheel_base,
+            } => {
+                let sl = dl * left_radius;
+                let sr = dr * right_radius;
+                ((sl + sr) / 2.0, (sr - sl) / wheel_base)
+            }
+            OdometryModel::Ackermann {
+                wheel_radius,
+                wheelbase,
+            } => {
+                let s = dl * wheel_radius;
+                (s, s * steer.tan() / wheelbase)
+            }
+        };
+        self.pose = crate::body::kinematics::integrate_arc(&self.pose, ds, dth, 1.0);
+        self.stamp = stamp;
+    }
+}
+
+/// The pose a robot believes it has — what controllers and planners use. Written by the estimator
+/// selected for navigation (wheel odometry until localization takes over).
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct NavBelief {
+    pub pose: Pose2,
+    pub stamp: f64,
+}
+
+/// Estimate: integrate this tick's encoder readings.
+pub fn integrate_odometry(
+    mut robots: Query<(&EncoderReadings, &mut WheelOdometry, Option<&mut NavBelief>)>,
+) {
+    for (readings, mut odom, belief) in robots.iter_mut() {
+        for r in &readings.readings {
+            odom.update(r.left_ticks, r.right_ticks, r.steer, r.stamp);
+        }
+        if let Some(mut b) = belief {
+            b.pose = odom.pose;
+            b.stamp = odom.stamp;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn straight_and_turn_in_place() {
+        let model = OdometryModel::DiffDrive {
+            left_radius: 0.1,
+            right_radius: 0.1,
+            wheel_base: 0.5,
+        };
+        let mut o = WheelOdometry::new(model.clone(), 1000, Pose2::IDENTITY);
+        o.update(0, 0, 0.0, 0.0);
+        // 1000 ticks = one revolution = 2π·0.1 m
+        o.update(1000, 1000, 0.0, 1.0);
+        assert!((o.pose.x - TAU * 0.1).abs() < 1e-12 && o.pose.y.abs() < 1e-12);
+        let mut o = WheelOdometry::new(model, 1000, Pose2::IDENTITY);
+        o.update(0, 0, 0.0, 0.0);
+        // wheels opposite by a quarter of the base circle: dθ = (sr - sl)/b
+        o.update(-1000, 1000, 0.0, 1.0);
+        assert!((o.pose.theta - wrap(2.0 * TAU * 0.1 / 0.5)).abs() < 1e-12);
+        assert!(o.pose.x.abs() < 1e-12);
+    }
+
+    fn wrap(a: f64) -> f64 {
+        crate::core::wrap_angle(a)
+    }
+
+    #[test]
+    fn unequal_radii_curve() {
+        // right wheel believed 1 % larger: equal ticks → odometry turns left
+        let model = OdometryModel::DiffDrive {
+            left_radius: 0.1,
+            right_radius: 0.101,
+            wheel_base: 0.5,
+        };
+        let mut o = WheelOdometry::new(model, 1000, Pose2::IDENTITY);
+        for i in 0..=100 {
+            o.update(i * 100, i * 100, 0.0, i as f64);
+        }
+        assert!(o.pose.theta > 0.05 && o.pose.y > 0.1, "{:?}", o.pose);
+    }
+}

@@ -1,0 +1,159 @@
+//! Reactive obstacle avoidance on a laser scan, in the spirit of the vector field histogram
+//! (Borenstein & Koren 1991): the scan is reduced to the minimum range per angular sector around
+//! the robot; a candidate heading is blocked at the nearest sector reading whose lateral offset
+//! from that heading is within the robot's half width; the behaviour then takes the free heading
+//! closest to the one it wants. O(beams + sectors × candidates) per scan.
+
+use crate::core::Pose2;
+use crate::sensors::LaserScan;
+use std::f64::consts::PI;
+
+pub const SECTORS: usize = 72;
+const SECTOR_WIDTH: f64 = 2.0 * PI / SECTORS as f64;
+
+/// Minimum range per 5° sector in the robot's base frame (+Inf where nothing was seen).
+#[derive(Clone, Debug)]
+pub struct SectorRanges {
+    pub mins: [f32; SECTORS],
+    /// Whether each sector was covered by the laser at all.
+    pub seen: [bool; SECTORS],
+}
+
+impl Default for SectorRanges {
+    fn default() -> Self {
+        SectorRanges {
+            mins: [f32::INFINITY; SECTORS],
+            seen: [false; SECTORS],
+        }
+    }
+}
+
+fn sector_of(angle: f64) -> usize {
+    let a = crate::core::wrap_angle(angle) + PI; // (0, 2π]
+    ((a / SECTOR_WIDTH) as usize).min(SECTORS - 1)
+}
+
+fn sector_centre(s: usize) -> f64 {
+    -PI + (s as f64 + 0.5) * SECTOR_WIDTH
+}
+
+impl SectorRanges {
+    pub fn from_scan(scan: &LaserScan, mount: &Pose2) -> Self {
+        let mut out = SectorRanges::default();
+        for (k, &r) in scan.ranges.iter().enumerate() {
+            let a = scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
+            // a reading below range_min (-Inf) means something very close: treat it as range_min
+            let r = if r == f32::NEG_INFINITY {
+                scan.range_min
+            } else {
+                r
+            };
+            let (s, c) = (a + mount.theta).sin_cos();
+            let px = mount.x + c * r as f64;
+            let py = mount.y + s * r as f64;
+            let idx = sector_of(if r.is_finite() {
+                py.atan2(px)
+            } else {
+                a + mount.theta
+            });
+            out.seen[idx] = true;
+            if r.is_finite() {
+                let d = px.hypot(py) as f32;
+                if d < out.mins[idx] {
+                    out.mins[idx] = d;
+                }
+            }
+        }
+        out
+    }
+
+    /// Free distance along `heading` (base frame) for a body of half width `half_width`.
+    pub fn free_distance(&self, heading: f64, half_width: f64) -> f64 {
+        let mut free = f64::INFINITY;
+        for s in 0..SECTORS {
+            let r = self.mins[s] as f64;
+            if !r.is_finite() {
+                continue;
+            }
+            let d = crate::core::wrap_angle(sector_centre(s) - heading);
+            if d.abs() >= PI / 2.0 {
+                continue;
+            }
+            // the sector spans ±half a sector: use its closest edge to the heading
+            let d_edge = (d.abs() - SECTOR_WIDTH / 2.0).max(0.0);
+            if r * d_edge.sin() < half_width {
+                free = free.min(r * d_edge.cos());
+            }
+        }
+        free
+    }
+
+    /// Among headings within ±`max_dev` of `wanted` (steps of 5°), the one closest to `wanted`
+    /// whose free distance is at least `needed`; otherwise the one with the most room.
+    pub fn choose_heading(
+        &self,
+        wanted: f64,
+        half_width: f64,
+        needed: f64,
+        max_dev: f64,
+    ) -> (f64, f64) {
+        let step = SECTOR_WIDTH;
+        let n = (max_dev / step).floor() as i32;
+        let mut best_open = (wanted, self.free_distance(wanted, half_width));
+        if best_open.1 >= needed {
+            return best_open;
+        }
+        for k in 1..=n {
+            for sign in [1.0, -1.0] {
+                let h = wanted + sign * k as f64 * step;
+                let f = self.free_distance(h, half_width);
+                if f >= needed {
+                    return (h, f);
+                }
+                if f > best_open.1 {
+                    best_open = (h, f);
+                }
+            }
+        }
+        best_open
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wall_scan(dist: f32) -> LaserScan {
+        // a wall across the front at x = dist, 360° scan, nothing elsewhere
+        let n = 720;
+        let inc = (2.0 * PI / n as f64) as f32;
+        let ranges = (0..n)
+            .map(|k| {
+                let a = -PI as f32 + k as f32 * inc;
+                if a.cos() > 0.1 {
+                    dist / a.cos()
+                } else {
+                    f32::INFINITY
+                }
+            })
+            .collect();
+        LaserScan {
+            stamp: 0.0,
+            angle_min: -PI as f32,
+            angle_increment: inc,
+            range_min: 0.05,
+            range_max: 30.0,
+            ranges,
+        }
+    }
+
+    #[test]
+    fn a_wall_ahead_blocks_forward_but_not_sideways() {
+        let s = SectorRanges::from_scan(&wall_scan(2.0), &Pose2::IDENTITY);
+        let ahead = s.free_distance(0.0, 0.3);
+        assert!((ahead - 2.0).abs() < 0.05, "{ahead}");
+        assert!(s.free_distance(PI / 2.0, 0.3) > 10.0);
+        let (h, f) = s.choose_heading(0.0, 0.3, 3.0, PI);
+        assert!(h.abs() > 0.5 && f >= 3.0, "{h} {f}");
+    }
+}

@@ -1,0 +1,175 @@
+//! Simple driving behaviours so robots move meaningfully before planners exist: waypoint
+//! following (go-to-point on the belief pose) and wander (a slowly varying random heading),
+//! both steering around obstacles seen by the laser ([`super::avoid`]).
+
+use super::avoid::SectorRanges;
+use crate::body::{DriveCommand, Kinematics};
+use crate::core::{Pose2, SimClock, SimRng, wrap_angle};
+use crate::localization::NavBelief;
+use crate::sensors::{Laser, LaserScans};
+use bevy_ecs::prelude::*;
+use rand::RngExt;
+use std::f64::consts::PI;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum BehaviourKind {
+    /// Stand still.
+    Idle,
+    /// Visit the points in order; start over after the last one if `looping`.
+    Waypoints {
+        points: Vec<[f64; 2]>,
+        looping: bool,
+    },
+    /// Drive around, avoiding obstacles.
+    Wander,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NavStatus {
+    Idle,
+    Driving,
+    /// Every waypoint reached (non-looping routes).
+    Arrived,
+}
+
+#[derive(Component, Clone, Debug)]
+pub struct Behaviour {
+    pub kind: BehaviourKind,
+    /// Cruise speed (m/s).
+    pub speed: f64,
+    /// Yaw-rate limit (rad/s).
+    pub max_yaw_rate: f64,
+    /// Distance at which a waypoint counts as reached (m).
+    pub tolerance: f64,
+    /// Half of the robot's width plus a margin (m).
+    pub half_width: f64,
+    pub current: usize,
+    pub status: NavStatus,
+    /// Waypoints reached so far.
+    pub reached: u32,
+    sectors: Option<SectorRanges>,
+    rng: SimRng,
+    wander_offset: f64,
+    next_wander_change: f64,
+}
+
+impl Behaviour {
+    pub fn new(kind: BehaviourKind, speed: f64, half_width: f64, rng: SimRng) -> Self {
+        let status = match kind {
+            BehaviourKind::Idle => NavStatus::Idle,
+            _ => NavStatus::Driving,
+        };
+        Behaviour {
+            kind,
+            speed,
+            max_yaw_rate: 1.5,
+            tolerance: 0.4,
+            half_width,
+            current: 0,
+            status,
+            reached: 0,
+            sectors: None,
+            rng,
+            wander_offset: 0.0,
+            next_wander_change: 0.0,
+        }
+    }
+
+    /// Replaces the route (scenario event): start from its first point.
+    pub fn set_waypoints(&mut self, points: Vec<[f64; 2]>, looping: bool) {
+        self.kind = BehaviourKind::Waypoints { points, looping };
+        self.current = 0;
+        self.status = NavStatus::Driving;
+    }
+
+    /// Wanted heading relative to the robot (rad), or None when there is nothing to do.
+    fn wanted_bearing(&mut self, belief: &Pose2, now: f64) -> Option<f64> {
+        match &self.kind {
+            BehaviourKind::Idle => None,
+            BehaviourKind::Waypoints { points, looping } => {
+                if points.is_empty() {
+                    self.status = NavStatus::Arrived;
+                    return None;
+                }
+                loop {
+                    if self.current >= points.len() {
+                        if *looping {
+                            self.current = 0;
+                        } else {
+                            self.status = NavStatus::Arrived;
+                            return None;
+                        }
+                    }
+                    let p = points[self.current];
+                    let d = (p[0] - belief.x).hypot(p[1] - belief.y);
+                    if d < self.tolerance {
+                        self.current += 1;
+                        self.reached += 1;
+                        continue;
+                    }
+                    return Some(wrap_angle(
+                        (p[1] - belief.y).atan2(p[0] - belief.x) - belief.theta,
+                    ));
+                }
+            }
+            BehaviourKind::Wander => {
+                if now >= self.next_wander_change {
+                    self.wander_offset = self.rng.random_range(-PI / 3.0..PI / 3.0);
+                    self.next_wander_change = now + self.rng.random_range(2.0..6.0);
+                }
+                Some(self.wander_offset * 0.5)
+            }
+        }
+    }
+
+    /// The drive command for this tick.
+    pub fn command(&mut self, belief: &Pose2, now: f64, kin: &Kinematics) -> DriveCommand {
+        let Some(wanted) = self.wanted_bearing(belief, now) else {
+            return DriveCommand::default();
+        };
+        let lookahead = 1.0 + self.speed;
+        let (heading, free) = match &self.sectors {
+            Some(s) => s.choose_heading(wanted, self.half_width, lookahead, PI * 0.8),
+            None => (wanted, f64::INFINITY),
+        };
+        if matches!(self.kind, BehaviourKind::Wander) && free < lookahead {
+            // remember the way out so wander does not oscillate
+            self.wander_offset = heading;
+        }
+        let car = matches!(kin, Kinematics::Ackermann(_));
+        let slow = ((free - 0.3) / lookahead).clamp(0.0, 1.0);
+        let mut v = self.speed * slow * heading.cos().max(0.0);
+        if !car && heading.abs() > PI / 3.0 {
+            v = 0.0; // turn in place first
+        }
+        if car && v < 0.1 * self.speed {
+            v = 0.1 * self.speed; // a car must roll to turn
+        }
+        let w = (2.0 * heading).clamp(-self.max_yaw_rate, self.max_yaw_rate);
+        DriveCommand { v, w }
+    }
+}
+
+/// Control: every robot's behaviour produces its drive command.
+pub fn drive_behaviours(
+    clock: Res<SimClock>,
+    mut robots: Query<(
+        &mut Behaviour,
+        &NavBelief,
+        &Kinematics,
+        &mut DriveCommand,
+        Option<(&Laser, &LaserScans)>,
+    )>,
+) {
+    let now = clock.start();
+    for (mut b, belief, kin, mut cmd, laser) in robots.iter_mut() {
+        if let Some((laser, scans)) = laser {
+            if let Some(scan) = scans.scans.last() {
+                b.sectors = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+            } else if !laser.enabled {
+                b.sectors = None;
+            }
+        }
+        *cmd = b.command(&belief.pose, now, kin);
+    }
+}

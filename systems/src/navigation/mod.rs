@@ -1,0 +1,19 @@
+//! Driving behaviours (Control set). For now: waypoint following and a laser-based wander, both
+//! with reactive obstacle avoidance on the latest scan. They read the robot's belief
+//! ([`NavBelief`](crate::localization::NavBelief)) and its sensor readings, never ground truth.
+
+pub mod avoid;
+pub mod behaviour;
+
+pub use behaviour::{Behaviour, BehaviourKind, NavStatus};
+
+use crate::core::{SimPlugin, SimSet};
+use bevy_ecs::prelude::*;
+
+pub struct NavigationPlugin;
+
+impl SimPlugin for NavigationPlugin {
+    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
+        schedule.add_systems(behaviour::drive_behaviours.in_set(SimSet::Control));
+    }
+}

@@ -1,0 +1,296 @@
+//! 2-D laser scanner. Fires at its own rate on the simulation clock (several times per tick if
+//! needed, at the pose interpolated to each firing time), casts every beam against the static map
+//! and the other robots' footprints, then applies the noise model: Gaussian range noise and
+//! random dropouts. Readings follow sensor_msgs/LaserScan and REP 117: no return = +Inf, a
+//! reading below range_min = -Inf. Scans of all robots are cast in parallel on the kernel pool,
+//! each laser drawing only from its own random stream, so results do not depend on threads.
+
+use super::others::RobotOutlines;
+use crate::body::TruePose;
+use crate::core::clock::RateTimer;
+use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimRng};
+use crate::raycast::{overlay_circles, overlay_segments};
+use crate::world::StaticWorld;
+use bevy_ecs::prelude::*;
+use rand::RngExt;
+use rand_distr::StandardNormal;
+use rayon::prelude::*;
+
+/// Laser parameters (SI units, angles in radians).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LaserSpec {
+    /// Total field of view, centred on the sensor's x axis.
+    pub fov: f64,
+    /// Angle between beams.
+    pub increment: f64,
+    pub min_range: f64,
+    pub max_range: f64,
+    /// Scans per second.
+    pub rate: f64,
+    /// Standard deviation of the range noise (m).
+    pub noise_std: f64,
+    /// Probability that a beam returns nothing.
+    pub dropout: f64,
+    /// Sensor pose in the robot's base frame.
+    pub mount: Pose2,
+}
+
+impl LaserSpec {
+    /// SICK LMS100: 270°, 0.25° (1081 beams), 0.5–20 m, 50 Hz, 12 mm (1σ) statistical error.
+    pub fn sick_lms100() -> Self {
+        LaserSpec {
+            fov: 270f64.to_radians(),
+            increment: 0.25f64.to_radians(),
+            min_range: 0.5,
+            max_range: 20.0,
+            rate: 50.0,
+            noise_std: 0.012,
+            dropout: 0.0,
+            mount: Pose2::IDENTITY,
+        }
+    }
+
+    /// Hokuyo URG-04LX: 240°, 0.36°, 0.02–5.6 m, 10 Hz, ±30 mm (taken as 3σ).
+    pub fn hokuyo_urg04lx() -> Self {
+        LaserSpec {
+            fov: 240f64.to_radians(),
+            increment: 0.36f64.to_radians(),
+            min_range: 0.02,
+            max_range: 5.6,
+            rate: 10.0,
+            noise_std: 0.01,
+            dropout: 0.0,
+            mount: Pose2::IDENTITY,
+        }
+    }
+
+    pub fn preset(name: &str) -> Option<Self> {
+        match name {
+            "sick_lms100" => Some(Self::sick_lms100()),
+            "hokuyo_urg04lx" => Some(Self::hokuyo_urg04lx()),
+            _ => None,
+        }
+    }
+
+    pub const PRESETS: [&'static str; 2] = ["sick_lms100", "hokuyo_urg04lx"];
+
+    /// Number of beams: fov / increment + 1 (both ends included).
+    pub fn beams(&self) -> usize {
+        (self.fov / self.increment + 1e-6).floor() as usize + 1
+    }
+
+    pub fn angle_min(&self) -> f64 {
+        -self.fov / 2.0
+    }
+}
+
+/// One scan, as sensor_msgs/LaserScan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LaserScan {
+    /// Simulation time of the scan (s).
+    pub stamp: f64,
+    pub angle_min: f32,
+    pub angle_increment: f32,
+    pub range_min: f32,
+    pub range_max: f32,
+    pub ranges: Vec<f32>,
+}
+
+impl LaserScan {
+    /// Beam endpoints of finite readings in the sensor frame.
+    pub fn points(&self) -> impl Iterator<Item = [f32; 2]> + '_ {
+        self.ranges.iter().enumerate().filter_map(|(k, &r)| {
+            if !r.is_finite() {
+                return None;
+            }
+            let a = self.angle_min + k as f32 * self.angle_increment;
+            Some([r * a.cos(), r * a.sin()])
+        })
+    }
+}
+
+#[derive(Component, Clone, Debug)]
+pub struct Laser {
+    pub spec: LaserSpec,
+    pub rng: SimRng,
+    pub timer: RateTimer,
+    /// False while a scripted fault is active: the sensor produces nothing.
+    pub enabled: bool,
+}
+
+impl Laser {
+    pub fn new(spec: LaserSpec, rng: SimRng) -> Self {
+        let timer = RateTimer::new(spec.rate, 0.0);
+        Laser {
+            spec,
+            rng,
+            timer,
+            enabled: true,
+        }
+    }
+}
+
+/// Readings: the scans of the current tick (estimators consume these) and the latest one.
+#[derive(Component, Clone, Debug, Default)]
+pub struct LaserScans {
+    pub scans: Vec<LaserScan>,
+    pub latest: Option<LaserScan>,
+}
+
+/// The true sensor pose of each scan of this tick (for evaluation and recording only).
+#[derive(Component, Clone, Debug, Default)]
+pub struct LaserTruth {
+    pub poses: Vec<Pose2>,
+    pub latest: Option<Pose2>,
+}
+
+/// Applies the noise model to exact ranges in place.
+pub fn apply_noise(spec: &LaserSpec, rng: &mut SimRng, ranges: &mut [f32]) {
+    let max = spec.max_range as f32;
+    let min = spec.min_range as f32;
+    for r in ranges.iter_mut() {
+        // draw both numbers for every beam so the stream's use does not depend on the geometry
+        let drop: f64 = rng.random();
+        let n: f64 = rng.sample(StandardNormal);
+        if drop < spec.dropout || !r.is_finite() || *r > max {
+            *r = f32::INFINITY;
+            continue;
+        }
+        let noisy = *r + (n * spec.noise_std) as f32;
+        *r = if noisy < min {
+            f32::NEG_INFINITY
+        } else if noisy > max {
+            f32::INFINITY
+        } else {
+            noisy
+        };
+    }
+}
+
+struct Scratch {
+    circles: Vec<[f32; 3]>,
+    segments: Vec<[f32; 4]>,
+    ids: Vec<u32>,
+    due: Vec<f64>,
+}
+
+/// Sense: every laser takes the scans due in this tick.
+#[allow(clippy::type_complexity)]
+pub fn sample_lasers(
+    clock: Res<SimClock>,
+    world: Res<StaticWorld>,
+    outlines: Res<RobotOutlines>,
+    pool: Res<KernelPool>,
+    mut lasers: Query<(
+        &RobotIndex,
+        &TruePose,
+        &mut Laser,
+        &mut LaserScans,
+        &mut LaserTruth,
+    )>,
+) {
+    let (start, end, dt) = (clock.start(), clock.now(), clock.dt);
+    let mut jobs: Vec<_> = lasers.iter_mut().collect();
+    let rays = world.rays();
+    let outlines = &*outlines;
+    pool.install(|| {
+        jobs.par_iter_mut().for_each_init(
+            || Scratch {
+                circles: Vec::new(),
+                segments: Vec::new(),
+                ids: Vec::new(),
+                due: Vec::new(),
+            },
+            |s, (index, truth, laser, scans, laser_truth)| {
+                scans.scans.clear();
+                laser_truth.poses.clear();
+                let laser = &mut **laser;
+                laser.timer.due(start, end, &mut s.due);
+                if !laser.enabled {
+                    return;
+                }
+                let spec = &laser.spec;
+                let n = spec.beams();
+                for &t in &s.due {
+                    let f = ((t - start) / dt).clamp(0.0, 1.0);
+                    let sensor = truth.interpolate(f).compose(&spec.mount);
+                    let p = [sensor.x as f32, sensor.y as f32];
+                    let a0 = (sensor.theta + spec.angle_min()) as f32;
+                    let inc = spec.increment as f32;
+                    let mut ranges = vec![0f32; n];
+                    rays.cast_scan(p, a0, inc, spec.max_range as f32, &mut ranges);
+                    outlines.near(
+                        sensor.x,
+                        sensor.y,
+                        spec.max_range + 1.0,
+                        index.0,
+                        &mut s.circles,
+                        &mut s.segments,
+                        &mut s.ids,
+                    );
+                    overlay_circles(p, a0, inc, &mut ranges, &s.circles);
+                    overlay_segments(p, a0, inc, &mut ranges, &s.segments);
+                    apply_noise(spec, &mut laser.rng, &mut ranges);
+                    scans.scans.push(LaserScan {
+                        stamp: t,
+                        angle_min: spec.angle_min() as f32,
+                        angle_increment: inc,
+                        range_min: spec.min_range as f32,
+                        range_max: spec.max_range as f32,
+                        ranges,
+                    });
+                    laser_truth.poses.push(sensor);
+                }
+                if let Some(last) = scans.scans.last() {
+                    scans.latest = Some(last.clone());
+                    laser_truth.latest = laser_truth.poses.last().copied();
+                }
+            },
+        );
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+
+    #[test]
+    fn presets_have_the_datasheet_beam_counts() {
+        assert_eq!(LaserSpec::sick_lms100().beams(), 1081);
+        assert_eq!(LaserSpec::hokuyo_urg04lx().beams(), 667);
+    }
+
+    #[test]
+    fn noise_has_the_configured_spread_and_dropout() {
+        let mut spec = LaserSpec::sick_lms100();
+        spec.noise_std = 0.05;
+        spec.dropout = 0.1;
+        let mut rng = stream_rng(1, "r", "laser");
+        let mut ranges = vec![5.0f32; 100_000];
+        apply_noise(&spec, &mut rng, &mut ranges);
+        let finite: Vec<f64> = ranges
+            .iter()
+            .filter(|r| r.is_finite())
+            .map(|&r| r as f64)
+            .collect();
+        let drop = 1.0 - finite.len() as f64 / ranges.len() as f64;
+        assert!((drop - 0.1).abs() < 0.01, "dropout {drop}");
+        let mean = finite.iter().sum::<f64>() / finite.len() as f64;
+        let var = finite.iter().map(|r| (r - mean).powi(2)).sum::<f64>() / finite.len() as f64;
+        assert!((mean - 5.0).abs() < 0.002, "mean {mean}");
+        assert!((var.sqrt() - 0.05).abs() < 0.002, "std {}", var.sqrt());
+    }
+
+    #[test]
+    fn out_of_range_readings_follow_rep_117() {
+        let spec = LaserSpec::sick_lms100();
+        let mut rng = stream_rng(1, "r", "laser");
+        let mut ranges = vec![f32::INFINITY, 25.0, 0.1, 3.0];
+        apply_noise(&spec, &mut rng, &mut ranges);
+        assert_eq!(ranges[0], f32::INFINITY);
+        assert_eq!(ranges[1], f32::INFINITY);
+        assert_eq!(ranges[2], f32::NEG_INFINITY);
+        assert!((ranges[3] - 3.0).abs() < 0.1);
+    }
+}

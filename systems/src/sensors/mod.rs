@@ -1,0 +1,30 @@
+//! Sensors: each is a component holding its parameters, its own random stream and rate timer, and
+//! a sampling system in [`SimSet::Sense`](crate::core::SimSet::Sense) that reads ground truth and
+//! writes readings shaped like the ROS messages they are recorded as.
+
+pub mod encoder;
+pub mod laser;
+pub mod others;
+
+pub use encoder::{Encoder, EncoderReading, EncoderReadings, EncoderSpec};
+pub use laser::{Laser, LaserScan, LaserScans, LaserSpec, LaserTruth};
+
+use crate::core::{SimPlugin, SimSet};
+use bevy_ecs::prelude::*;
+
+pub struct SensorsPlugin;
+
+impl SimPlugin for SensorsPlugin {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        world.init_resource::<others::RobotOutlines>();
+        schedule.add_systems(
+            (
+                others::update_robot_outlines,
+                laser::sample_lasers,
+                encoder::sample_encoders,
+            )
+                .chain()
+                .in_set(SimSet::Sense),
+        );
+    }
+}

@@ -1,0 +1,14 @@
+//! The static environment: the occupancy grid (from ROS map_server files and/or vector shapes),
+//! its ray-casting structure and the tiles its physics colliders are built from. Local edits
+//! (doors) change the grid, the ray map and the affected collider tiles only.
+
+pub mod grid;
+pub mod map_file;
+pub mod rects;
+pub mod shapes;
+pub mod static_world;
+
+pub use grid::{Cell, OccupancyGrid};
+pub use map_file::{MapError, load_map};
+pub use shapes::Shape;
+pub use static_world::{COLLIDER_TILE, StaticWorld};

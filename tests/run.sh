@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Runs every test of the workspace, in release mode.
+#
+# The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
+# the Python SDK's RrdReader); this script installs rerun-sdk==0.36.3 from PyPI into a virtual
+# environment once (under $SIM_CACHE, default ~/.cache/sim) and points the tests at it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cache="${SIM_CACHE:-$HOME/.cache/sim}"
+venv="$cache/venv-rerun-0.36.3"
+if ! "$venv/bin/rerun" --version 2>/dev/null | grep -q "0.36.3"; then
+    echo "setting up rerun-sdk 0.36.3 in $venv"
+    mkdir -p "$cache"
+    rm -rf "$venv"
+    python3 -m venv "$venv"
+    "$venv/bin/pip" install --quiet --disable-pip-version-check "rerun-sdk==0.36.3"
+    "$venv/bin/rerun" analytics disable >/dev/null 2>&1 || true
+fi
+export SIM_RERUN_VENV="$venv"
+
+cargo test --release --workspace

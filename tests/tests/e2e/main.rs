@@ -1,0 +1,9 @@
+//! End-to-end tests: scenario in, metrics and files out. One test binary (every binary links
+//! rerun, so few binaries keep builds short).
+
+mod common;
+mod determinism;
+mod physics;
+mod recording;
+mod scenarios;
+mod sensors;

@@ -1,0 +1,172 @@
+//! Scenario files: bundled ones load; bad input gives errors naming file, line and key.
+
+use crate::common::*;
+use sim::scenario::{bundled_scenarios, load_scenario};
+
+#[test]
+fn bundled_scenarios_load() {
+    let all = bundled_scenarios();
+    let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
+    assert!(names.contains(&"hospital_patrol"), "{names:?}");
+    assert!(names.contains(&"maze_run"), "{names:?}");
+    for (name, path) in &all {
+        let s = load_scenario(path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(!s.robots.is_empty(), "{name} has robots");
+    }
+    let h = load_scenario(&bundled("hospital_patrol")).unwrap();
+    assert!(h.robots.len() >= 4);
+    for r in &h.robots {
+        let l = r.laser.as_ref().expect("every patrol robot has a laser");
+        assert_eq!(l.beams(), 1081, "SICK LMS100");
+        assert!(r.encoder.is_some());
+    }
+}
+
+fn with_robot(robot: &str) -> String {
+    format!("{SQUARE_ROOM}\n[[robots]]\nname = \"r1\"\nstart = [5.0, 5.0, 0.0]\n{robot}\n")
+}
+
+/// (line, expected fragments) of an error.
+fn expect_error(text: &str, line: usize, fragments: &[&str]) {
+    let e = scenario_error(text);
+    assert!(
+        e.starts_with(&format!("test.toml:{line}:")),
+        "expected line {line} in: {e}"
+    );
+    for f in fragments {
+        assert!(e.contains(f), "expected `{f}` in: {e}");
+    }
+}
+
+#[test]
+fn unknown_top_level_key() {
+    expect_error("duration = 1.0\ncolour = \"red\"\n", 2, &["colour"]);
+}
+
+#[test]
+fn unknown_nested_key() {
+    let text = with_robot("[robots.sensors.laser]\npreset = \"sick_lms100\"\nfrequency = 10.0\n");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("frequency"))
+        .unwrap()
+        + 1;
+    expect_error(&text, line, &["frequency"]);
+}
+
+#[test]
+fn out_of_range_values_name_the_key() {
+    let text = with_robot("[robots.sensors.laser]\ndropout = 1.5\n");
+    let line = text.lines().position(|l| l.starts_with("dropout")).unwrap() + 1;
+    expect_error(
+        &text,
+        line,
+        &["robots[0].sensors.laser.dropout", "[0, 1]", "1.5"],
+    );
+
+    let text = format!("{SQUARE_ROOM}\n").replace("dt = 0.05", "dt = -0.1");
+    let line = text.lines().position(|l| l.starts_with("dt")).unwrap() + 1;
+    expect_error(&text, line, &["`dt`", "-0.1"]);
+
+    let text = with_robot("kinematics = { type = \"diff_drive\", wheel_radius = 0.0 }\n");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("kinematics"))
+        .unwrap()
+        + 1;
+    expect_error(&text, line, &["wheel_radius", "greater than 0"]);
+}
+
+#[test]
+fn type_errors_and_bad_enums() {
+    let text = with_robot("[robots.sensors.laser]\nrate = \"fast\"\n");
+    let line = text.lines().position(|l| l.starts_with("rate")).unwrap() + 1;
+    expect_error(&text, line, &[]);
+    let text = with_robot("kinematics = { type = \"tank\" }\n");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("kinematics"))
+        .unwrap()
+        + 1;
+    expect_error(&text, line, &["tank"]);
+}
+
+#[test]
+fn semantic_errors() {
+    let e = scenario_error(&with_robot(
+        "[robots.sensors.laser]\npreset = \"velodyne\"\n",
+    ));
+    assert!(e.contains("velodyne") && e.contains("sick_lms100"), "{e}");
+    let e = scenario_error(&with_robot(
+        "kinematics = { type = \"diff_drive\", max_steer = 0.3 }\n",
+    ));
+    assert!(
+        e.contains("max_steer") && e.contains("does not apply"),
+        "{e}"
+    );
+    let e = scenario_error(&with_robot("[robots.sensors.laser]\nmin_range = 30.0\n"));
+    assert!(
+        e.contains("min_range") && e.contains("below max_range"),
+        "{e}"
+    );
+    // start inside a wall
+    let text = format!("{SQUARE_ROOM}\n[[robots]]\nname = \"r1\"\nstart = [0.05, 5.0, 0.0]\n");
+    let line = text.lines().position(|l| l.starts_with("start")).unwrap() + 1;
+    expect_error(&text, line, &["overlap an obstacle"]);
+    // outside the map
+    let e = scenario_error(&format!(
+        "{SQUARE_ROOM}\n[[robots]]\nname = \"r1\"\nstart = [50.0, 5.0, 0.0]\n"
+    ));
+    assert!(e.contains("outside the map"), "{e}");
+    // duplicate names
+    let text = format!(
+        "{SQUARE_ROOM}\n[[robots]]\nname = \"a\"\nstart = [2.0, 2.0, 0.0]\n[[robots]]\nname = \"a\"\nstart = [5.0, 5.0, 0.0]\n"
+    );
+    let e = scenario_error(&text);
+    assert!(e.contains("duplicate robot name"), "{e}");
+    // waypoints need odometry
+    let e = scenario_error(&with_robot(
+        "behaviour = { type = \"waypoints\", points = [[2.0, 2.0]] }\n",
+    ));
+    assert!(e.contains("encoder"), "{e}");
+    // unknown place
+    let e = scenario_error(&with_robot(
+        "behaviour = { type = \"waypoints\", points = [\"pharmacy\"] }\n[robots.sensors.encoder]\n",
+    ));
+    assert!(e.contains("unknown place `pharmacy`"), "{e}");
+    // events
+    let e = scenario_error(&format!(
+        "{}\n[[events]]\nat = 0.5\ntype = \"teleport\"\nrobot = \"nobody\"\npose = [1.0, 1.0, 0.0]\n",
+        with_robot("")
+    ));
+    assert!(e.contains("no robot named `nobody`"), "{e}");
+    let e = scenario_error(&format!(
+        "{}\n[[events]]\nat = 5.0\ntype = \"sensor_fault\"\nrobot = \"r1\"\nsensor = \"laser\"\n",
+        with_robot("[robots.sensors.laser]\n")
+    ));
+    assert!(e.contains("events[0].at"), "{e}");
+    let e = scenario_error(&format!(
+        "{}\n[[events]]\nat = 0.5\ntype = \"sensor_fault\"\nrobot = \"r1\"\nsensor = \"encoder\"\n",
+        with_robot("")
+    ));
+    assert!(e.contains("no encoder sensor"), "{e}");
+    // no world
+    let e = scenario_error("duration = 3.0\n");
+    assert!(e.contains("world is empty"), "{e}");
+    let e = scenario_error("walls = [{ from = [0.0, 0.0], to = [1.0, 0.0] }]\n");
+    assert!(e.contains("duration"), "{e}");
+}
+
+#[test]
+fn missing_map_file_is_reported_with_its_key() {
+    let text = "duration = 1.0\n[map]\nfile = \"../maps/nowhere/none.yaml\"\n";
+    let e = scenario_error(text);
+    assert!(e.starts_with("test.toml:3:"), "{e}");
+    assert!(e.contains("map.file") && e.contains("none.yaml"), "{e}");
+}
+
+#[test]
+fn places_resolve_from_the_map_places_file() {
+    let s = load_scenario(&bundled("hospital_patrol")).unwrap();
+    assert!(s.places.contains_key("pharmacy"), "{:?}", s.places.keys());
+}
