@@ -27,7 +27,7 @@ enum Command {
         #[arg(long)]
         seed: Option<u64>,
         /// Override the scenario's duration (simulated seconds).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         duration: Option<f64>,
         /// Where to write the Rerun recording (default: <scenario>-seed<N>.rrd here).
         #[arg(long, conflicts_with = "no_rrd")]

@@ -5,6 +5,7 @@
 //! - `robots/<name>/body`: the footprint outline;
 //! - `robots/<name>/odometry`: wheel-odometry pose and path;
 //! - `robots/<name>/scan`: the latest scan's endpoints in the world frame.
+//!
 //! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
 
 use crate::scenario::RecordConfig;

@@ -116,6 +116,48 @@ pub fn span_of(root: &DeTable<'_>, path: &KeyPath) -> Option<std::ops::Range<usi
     best
 }
 
+/// Depth-first search for the deepest key whose name or scalar value contains `offset`
+/// (tables opened by `[a.b]` headers do not span their contents, so every branch is searched).
+fn search(v: &DeValue<'_>, offset: usize, path: &mut KeyPath, best: &mut Option<KeyPath>) {
+    match v {
+        DeValue::Table(t) => {
+            for (k, v) in t.iter() {
+                path.0.push(Seg::Key(k.get_ref().to_string()));
+                let scalar = !matches!(v.get_ref(), DeValue::Table(_) | DeValue::Array(_));
+                if k.span().contains(&offset) || (scalar && v.span().contains(&offset)) {
+                    *best = Some(path.clone());
+                }
+                search(v.get_ref(), offset, path, best);
+                path.0.pop();
+            }
+        }
+        DeValue::Array(a) => {
+            for (i, item) in a.iter().enumerate() {
+                path.0.push(Seg::Index(i));
+                let scalar = !matches!(item.get_ref(), DeValue::Table(_) | DeValue::Array(_));
+                if scalar && item.span().contains(&offset) {
+                    *best = Some(path.clone());
+                }
+                search(item.get_ref(), offset, path, best);
+                path.0.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The deepest key whose name or value contains byte `offset`.
+pub fn key_at(root: &DeTable<'_>, offset: usize) -> Option<KeyPath> {
+    let mut best = None;
+    search(
+        &DeValue::Table(root.clone()),
+        offset,
+        &mut KeyPath::default(),
+        &mut best,
+    );
+    best
+}
+
 /// Builds errors for one scenario text.
 pub struct ErrorContext<'a> {
     pub file: String,
@@ -155,11 +197,15 @@ impl<'a> ErrorContext<'a> {
             }
             None => (None, None),
         };
+        let key = match (e.span(), &self.doc) {
+            (Some(s), Some(doc)) => key_at(doc, s.start).map(|k| k.to_string()),
+            _ => None,
+        };
         ScenarioError {
             file: self.file.clone(),
             line,
             column,
-            key: None,
+            key,
             message: e.message().trim().to_string(),
         }
     }

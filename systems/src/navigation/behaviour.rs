@@ -151,6 +151,7 @@ impl Behaviour {
 }
 
 /// Control: every robot's behaviour produces its drive command.
+#[allow(clippy::type_complexity)]
 pub fn drive_behaviours(
     clock: Res<SimClock>,
     mut robots: Query<(

@@ -5,7 +5,7 @@
 //! reading below range_min = -Inf. Scans of all robots are cast in parallel on the kernel pool,
 //! each laser drawing only from its own random stream, so results do not depend on threads.
 
-use super::others::RobotOutlines;
+use super::others::{NearbyRobots, RobotOutlines};
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;
 use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimRng};
@@ -167,10 +167,9 @@ pub fn apply_noise(spec: &LaserSpec, rng: &mut SimRng, ranges: &mut [f32]) {
     }
 }
 
+#[derive(Default)]
 struct Scratch {
-    circles: Vec<[f32; 3]>,
-    segments: Vec<[f32; 4]>,
-    ids: Vec<u32>,
+    near: NearbyRobots,
     due: Vec<f64>,
 }
 
@@ -195,12 +194,7 @@ pub fn sample_lasers(
     let outlines = &*outlines;
     pool.install(|| {
         jobs.par_iter_mut().for_each_init(
-            || Scratch {
-                circles: Vec::new(),
-                segments: Vec::new(),
-                ids: Vec::new(),
-                due: Vec::new(),
-            },
+            Scratch::default,
             |s, (index, truth, laser, scans, laser_truth)| {
                 scans.scans.clear();
                 laser_truth.poses.clear();
@@ -224,12 +218,10 @@ pub fn sample_lasers(
                         sensor.y,
                         spec.max_range + 1.0,
                         index.0,
-                        &mut s.circles,
-                        &mut s.segments,
-                        &mut s.ids,
+                        &mut s.near,
                     );
-                    overlay_circles(p, a0, inc, &mut ranges, &s.circles);
-                    overlay_segments(p, a0, inc, &mut ranges, &s.segments);
+                    overlay_circles(p, a0, inc, &mut ranges, &s.near.circles);
+                    overlay_segments(p, a0, inc, &mut ranges, &s.near.segments);
                     apply_noise(spec, &mut laser.rng, &mut ranges);
                     scans.scans.push(LaserScan {
                         stamp: t,

@@ -8,6 +8,14 @@ use bevy_ecs::prelude::*;
 /// Bucket side (m).
 const BUCKET: f64 = 4.0;
 
+/// Reusable output of [`RobotOutlines::near`].
+#[derive(Default)]
+pub struct NearbyRobots {
+    pub circles: Vec<[f32; 3]>,
+    pub segments: Vec<[f32; 4]>,
+    ids: Vec<u32>,
+}
+
 #[derive(Resource, Default)]
 pub struct RobotOutlines {
     /// Per robot (by index): circle (cx, cy, r) or polygon edges.
@@ -20,16 +28,12 @@ pub struct RobotOutlines {
 impl RobotOutlines {
     /// Robots (other than `except`) whose bounding discs come within `range` of (x, y), in index
     /// order, as circles and segments.
-    pub fn near(
-        &self,
-        x: f64,
-        y: f64,
-        range: f64,
-        except: u32,
-        circles: &mut Vec<[f32; 3]>,
-        segments: &mut Vec<[f32; 4]>,
-        scratch: &mut Vec<u32>,
-    ) {
+    pub fn near(&self, x: f64, y: f64, range: f64, except: u32, out: &mut NearbyRobots) {
+        let NearbyRobots {
+            circles,
+            segments,
+            ids: scratch,
+        } = out;
         circles.clear();
         segments.clear();
         scratch.clear();

@@ -95,7 +95,7 @@ mod tests {
             s ^= s << 13;
             s ^= s >> 7;
             s ^= s << 17;
-            if s % 3 == 0 {
+            if s.is_multiple_of(3) {
                 g.cells[i] = Cell::Occupied;
             }
         }
@@ -116,9 +116,8 @@ mod tests {
                 }
             }
         }
-        for i in 0..g.cells.len() {
-            let want = (g.cells[i] == Cell::Occupied) as u8;
-            assert_eq!(covered[i], want, "cell {i}");
+        for (i, (cell, n)) in g.cells.iter().zip(&covered).enumerate() {
+            assert_eq!(*n, (*cell == Cell::Occupied) as u8, "cell {i}");
         }
     }
 
