@@ -10,7 +10,6 @@ pub mod core;
 pub mod eval;
 pub mod localization;
 pub mod navigation;
-#[path = "raycast_stub.rs"]
 pub mod raycast;
 pub mod sensors;
 pub mod world;

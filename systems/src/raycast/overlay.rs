@@ -1,0 +1,100 @@
+//! Moving obstacles (other robots) drawn into an already-cast scan: each obstacle maps to the
+//! beam-index interval it subtends from the sensor, and only those beams are intersected, so the
+//! cost is proportional to the beams actually covered.
+
+use std::f32::consts::{PI, TAU};
+
+/// Calls `f(k)` for every beam index k < n whose angle `start + k·inc` lies in the arc
+/// [lo, lo + width] (radians, any lo; width < 2π), handling wrap-around.
+fn beams_in_arc(start: f32, inc: f32, n: usize, lo: f32, width: f32, mut f: impl FnMut(usize)) {
+    let rel = (lo - start).rem_euclid(TAU);
+    let span = (n.saturating_sub(1)) as f32 * inc;
+    for shift in [0.0, -TAU] {
+        let a = rel + shift;
+        let b = a + width;
+        if b < 0.0 || a > span + 1e-6 {
+            continue;
+        }
+        let k0 = (a / inc).ceil().max(0.0) as usize;
+        let k1 = ((b / inc).floor() as isize).min(n as isize - 1);
+        if k1 < 0 {
+            continue;
+        }
+        for k in k0..=k1 as usize {
+            f(k);
+        }
+    }
+}
+
+/// Circles (cx, cy, radius): out[k] = min(out[k], distance to the circle along beam k). A sensor
+/// inside a circle sees 0 on every beam.
+pub fn overlay_circles(
+    p: [f32; 2],
+    start: f32,
+    increment: f32,
+    out: &mut [f32],
+    circles: &[[f32; 3]],
+) {
+    let n = out.len();
+    for &[cx, cy, r] in circles {
+        let (vx, vy) = (cx - p[0], cy - p[1]);
+        let d2 = vx * vx + vy * vy;
+        if d2 <= r * r {
+            out.iter_mut().for_each(|o| *o = 0.0);
+            continue;
+        }
+        let d = d2.sqrt();
+        let half = (r / d).asin();
+        let centre = vy.atan2(vx);
+        let c = d2 - r * r;
+        beams_in_arc(start, increment, n, centre - half, 2.0 * half, |k| {
+            let (sy, sx) = (start + k as f32 * increment).sin_cos();
+            let b = sx * vx + sy * vy;
+            let disc = b * b - c;
+            if disc >= 0.0 {
+                let t = b - disc.sqrt();
+                if t >= 0.0 && t < out[k] {
+                    out[k] = t;
+                }
+            }
+        });
+    }
+}
+
+/// Segments (x0, y0, x1, y1): out[k] = min(out[k], distance to the segment along beam k).
+pub fn overlay_segments(
+    p: [f32; 2],
+    start: f32,
+    increment: f32,
+    out: &mut [f32],
+    segments: &[[f32; 4]],
+) {
+    let n = out.len();
+    for &[x0, y0, x1, y1] in segments {
+        let (ax, ay) = (x0 - p[0], y0 - p[1]);
+        let (bx, by) = (x1 - p[0], y1 - p[1]);
+        let a0 = ay.atan2(ax);
+        let a1 = by.atan2(bx);
+        let mut diff = a1 - a0;
+        if diff > PI {
+            diff -= TAU;
+        } else if diff < -PI {
+            diff += TAU;
+        }
+        let (lo, width) = if diff >= 0.0 { (a0, diff) } else { (a1, -diff) };
+        let (ex, ey) = (bx - ax, by - ay);
+        beams_in_arc(start, increment, n, lo - 1e-6, width + 2e-6, |k| {
+            let (sy, sx) = (start + k as f32 * increment).sin_cos();
+            // solve t·s = a + u·e for t ≥ 0, u ∈ [0, 1]
+            let den = sx * ey - sy * ex;
+            if den.abs() < 1e-12 {
+                return;
+            }
+            let t = (ax * ey - ay * ex) / den;
+            let u = (ax * sy - ay * sx) / den;
+            if t >= 0.0 && (-1e-6..=1.0 + 1e-6).contains(&u) && t < out[k] {
+                out[k] = t;
+            }
+        });
+    }
+}

@@ -1,0 +1,294 @@
+use super::*;
+use std::f32::consts::PI;
+
+struct XorShift(u64);
+impl XorShift {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn f(&mut self) -> f32 {
+        (self.next() >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+struct Map {
+    w: usize,
+    h: usize,
+    res: f32,
+    origin: [f32; 2],
+    occ: Vec<bool>,
+}
+
+impl Map {
+    fn dda(&self, p: [f32; 2], a: f32, max: f32) -> f32 {
+        cast_dda(self.w, self.h, self.res, self.origin, &self.occ, p, a, max)
+    }
+    fn raymap(&self) -> RayMap {
+        RayMap::new(self.w, self.h, self.res, self.origin, &self.occ)
+    }
+    fn set(&mut self, c: usize, r: usize, v: bool) {
+        self.occ[r * self.w + c] = v;
+    }
+}
+
+/// 10 × 10 m room with inner faces at 0.1 and 9.9 (origin -1, -1; 5 cm cells).
+fn square_room() -> Map {
+    let (w, h) = (240, 240);
+    let mut m = Map {
+        w,
+        h,
+        res: 0.05,
+        origin: [-1.0, -1.0],
+        occ: vec![false; w * h],
+    };
+    for r in 0..h {
+        for c in 0..w {
+            let x = -1.0 + (c as f32 + 0.5) * 0.05;
+            let y = -1.0 + (r as f32 + 0.5) * 0.05;
+            let inside = (0.1..9.9).contains(&x) && (0.1..9.9).contains(&y);
+            let wall = (-0.1..10.1).contains(&x) && (-0.1..10.1).contains(&y);
+            m.set(c, r, wall && !inside);
+        }
+    }
+    m
+}
+
+fn room_range(x: f32, y: f32, a: f32) -> f32 {
+    let (dy, dx) = a.sin_cos();
+    let mut t = f32::INFINITY;
+    if dx > 1e-9 {
+        t = t.min((9.9 - x) / dx);
+    }
+    if dx < -1e-9 {
+        t = t.min((0.1 - x) / dx);
+    }
+    if dy > 1e-9 {
+        t = t.min((9.9 - y) / dy);
+    }
+    if dy < -1e-9 {
+        t = t.min((0.1 - y) / dy);
+    }
+    t
+}
+
+#[test]
+fn square_room_matches_closed_form() {
+    let m = square_room();
+    let rm = m.raymap();
+    let p = [3.3, 4.1];
+    let n = 1440;
+    let inc = 2.0 * PI / n as f32;
+    let mut out = vec![0.0; n];
+    rm.cast_scan(p, -PI, inc, 30.0, &mut out);
+    for (k, &r) in out.iter().enumerate() {
+        let a = -PI + k as f32 * inc;
+        let want = room_range(p[0], p[1], a);
+        assert!((r - want).abs() < 1e-3, "beam {k}: {r} vs {want}");
+        assert!((rm.cast(p, a, 30.0) - want).abs() < 1e-3);
+        assert!((m.dda(p, a, 30.0) - want).abs() < 1e-3);
+    }
+}
+
+fn random_map(seed: u64) -> Map {
+    let (w, h) = (400, 300);
+    let mut m = Map {
+        w,
+        h,
+        res: 0.05,
+        origin: [2.0, -3.0],
+        occ: vec![false; w * h],
+    };
+    let mut rng = XorShift(seed);
+    // room walls every ~80 cells with door gaps, plus pillars
+    for r in 0..h {
+        for c in 0..w {
+            let wall_x = c % 80 < 3 && !(r % 60 > 25 && r % 60 < 45);
+            let wall_y = r % 100 < 3 && !(c % 50 > 10 && c % 50 < 30);
+            if wall_x || wall_y {
+                m.set(c, r, true);
+            }
+        }
+    }
+    for _ in 0..60 {
+        let cx = (rng.f() * w as f32) as i32;
+        let cy = (rng.f() * h as f32) as i32;
+        let rad = 1 + (rng.f() * 6.0) as i32;
+        for r in (cy - rad).max(0)..(cy + rad).min(h as i32) {
+            for c in (cx - rad).max(0)..(cx + rad).min(w as i32) {
+                if (r - cy).pow(2) + (c - cx).pow(2) <= rad * rad {
+                    m.set(c as usize, r as usize, true);
+                }
+            }
+        }
+    }
+    m
+}
+
+fn random_free_point(m: &Map, rng: &mut XorShift) -> [f32; 2] {
+    loop {
+        let x = m.origin[0] + rng.f() * m.w as f32 * m.res;
+        let y = m.origin[1] + rng.f() * m.h as f32 * m.res;
+        let c = ((x - m.origin[0]) / m.res) as usize;
+        let r = ((y - m.origin[1]) / m.res) as usize;
+        if !m.occ[r * m.w + c] {
+            return [x, y];
+        }
+    }
+}
+
+fn agree(a: f32, b: f32) -> bool {
+    (a.is_infinite() && b.is_infinite()) || (a - b).abs() < 1e-3
+}
+
+#[test]
+fn raymap_agrees_with_dda_on_random_rays() {
+    let m = random_map(99);
+    let rm = m.raymap();
+    let mut rng = XorShift(7);
+    let mut mismatches = 0;
+    for _ in 0..20_000 {
+        let p = random_free_point(&m, &mut rng);
+        let a = rng.f() * 2.0 * PI - PI;
+        let max = 1.0 + rng.f() * 25.0;
+        let (x, y) = (rm.cast(p, a, max), m.dda(p, a, max));
+        if !agree(x, y) {
+            mismatches += 1;
+        }
+    }
+    assert_eq!(mismatches, 0);
+    // scans
+    for _ in 0..50 {
+        let p = random_free_point(&m, &mut rng);
+        let start = rng.f() * 10.0 - 5.0;
+        let inc = 0.25f32.to_radians();
+        let mut out = vec![0.0; 1081];
+        rm.cast_scan(p, start, inc, 20.0, &mut out);
+        for (k, r) in out.iter().enumerate() {
+            let want = m.dda(p, start + k as f32 * inc, 20.0);
+            assert!(agree(*r, want), "beam {k}: {r} vs {want}");
+        }
+    }
+}
+
+#[test]
+fn edits_open_and_close_a_door() {
+    let mut m = Map {
+        w: 200,
+        h: 100,
+        res: 0.05,
+        origin: [0.0, 0.0],
+        occ: vec![false; 200 * 100],
+    };
+    for r in 0..100 {
+        if !(40..60).contains(&r) {
+            m.set(100, r, true);
+        }
+    }
+    let mut rm = m.raymap();
+    let p = [2.0, 2.5];
+    assert!(rm.cast(p, 0.0, 20.0).is_infinite(), "open door");
+    let door: Vec<(usize, usize, bool)> = (40..60).map(|r| (100, r, true)).collect();
+    rm.set_cells(&door);
+    for &(c, r, v) in &door {
+        m.set(c, r, v);
+    }
+    assert!((rm.cast(p, 0.0, 20.0) - 3.0).abs() < 1e-4, "closed door");
+    let mut rng = XorShift(3);
+    for _ in 0..2000 {
+        let p = random_free_point(&m, &mut rng);
+        let a = rng.f() * 2.0 * PI;
+        assert!(agree(rm.cast(p, a, 20.0), m.dda(p, a, 20.0)));
+    }
+    let open: Vec<(usize, usize, bool)> = (40..60).map(|r| (100, r, false)).collect();
+    rm.set_cells(&open);
+    assert!(rm.cast(p, 0.0, 20.0).is_infinite(), "open again");
+    assert!(rm.is_occupied(100, 10) && !rm.is_occupied(100, 50));
+}
+
+#[test]
+fn edge_cases() {
+    let m = square_room();
+    let rm = m.raymap();
+    // inside an obstacle
+    assert_eq!(rm.cast([0.0, 5.0], 0.3, 20.0), 0.0);
+    assert_eq!(m.dda([0.0, 5.0], 0.3, 20.0), 0.0);
+    // origin outside the grid, looking in and looking away
+    let r = rm.cast([-5.0, 5.0], 0.0, 20.0);
+    assert!((r - 4.9).abs() < 1e-3, "{r}");
+    assert!(rm.cast([-5.0, 5.0], PI, 20.0).is_infinite());
+    // max range cut-off
+    assert!(rm.cast([5.0, 5.0], 0.0, 4.0).is_infinite());
+    assert!((rm.cast([5.0, 5.0], 0.0, 4.95) - 4.9).abs() < 1e-4);
+}
+
+#[test]
+fn circles_and_segments_overlay_analytically() {
+    // full 360° scan starting at -π; a circle behind the sensor (across the ±π wrap)
+    let n = 720;
+    let inc = 2.0 * PI / n as f32;
+    let mut out = vec![f32::INFINITY; n];
+    overlay_circles([0.0, 0.0], -PI, inc, &mut out, &[[-3.0, 0.0, 0.5]]);
+    assert!((out[0] - 2.5).abs() < 1e-4, "{}", out[0]);
+    let hit: Vec<usize> = (0..n).filter(|&k| out[k].is_finite()).collect();
+    let half = (0.5f32 / 3.0).asin();
+    let expected = (2.0 * half / inc).floor() as usize;
+    assert!(
+        hit.len() >= expected && hit.len() <= expected + 2,
+        "{}",
+        hit.len()
+    );
+    // beam at angle 0 misses it
+    assert!(out[n / 2].is_infinite());
+    // a farther obstacle does not override a nearer reading
+    let mut out = vec![1.0; n];
+    overlay_circles([0.0, 0.0], -PI, inc, &mut out, &[[3.0, 0.0, 0.5]]);
+    assert_eq!(out[n / 2], 1.0);
+    // segment across the +x axis at x = 2, seen by a 270° scan starting at -135°
+    let inc = 0.25f32.to_radians();
+    let mut out = vec![f32::INFINITY; 1081];
+    overlay_segments(
+        [0.0, 0.0],
+        -0.75 * PI,
+        inc,
+        &mut out,
+        &[[2.0, -1.0, 2.0, 1.0]],
+    );
+    for (k, r) in out.iter().enumerate() {
+        let a = -0.75 * PI + k as f32 * inc;
+        let want = if a.tan().abs() <= 0.5 && a.cos() > 0.0 {
+            2.0 / a.cos()
+        } else {
+            f32::INFINITY
+        };
+        assert!(
+            agree(*r, want) || (a.tan().abs() - 0.5).abs() < 1e-3,
+            "beam {k}: {r} vs {want}"
+        );
+    }
+    // segment behind the sensor is seen by a 360° scan only
+    let mut out = vec![f32::INFINITY; 1081];
+    overlay_segments(
+        [0.0, 0.0],
+        -0.75 * PI,
+        inc,
+        &mut out,
+        &[[-2.0, -1.0, -2.0, 1.0]],
+    );
+    assert!(out.iter().all(|r| r.is_infinite()));
+    let mut out = vec![f32::INFINITY; 1440];
+    overlay_segments(
+        [0.0, 0.0],
+        0.0,
+        2.0 * PI / 1440.0,
+        &mut out,
+        &[[-2.0, -1.0, -2.0, 1.0]],
+    );
+    assert!((out[720] - 2.0).abs() < 1e-4);
+    // sensor inside a circle
+    let mut out = vec![5.0; 10];
+    overlay_circles([0.0, 0.0], 0.0, 0.1, &mut out, &[[0.1, 0.0, 0.3]]);
+    assert!(out.iter().all(|r| *r == 0.0));
+}
