@@ -128,21 +128,26 @@ impl Behaviour {
             return DriveCommand::default();
         };
         let lookahead = 1.0 + self.speed;
-        let (heading, free) = match &self.sectors {
-            Some(s) => s.choose_heading(wanted, self.half_width, lookahead, PI * 0.8),
-            None => (wanted, f64::INFINITY),
+        let (heading, free, ahead) = match &self.sectors {
+            Some(s) => {
+                let (h, f) = s.choose_heading(wanted, self.half_width, lookahead, PI * 0.8);
+                (h, f, s.free_distance(0.0, self.half_width))
+            }
+            None => (wanted, f64::INFINITY, f64::INFINITY),
         };
         if matches!(self.kind, BehaviourKind::Wander) && free < lookahead {
             // remember the way out so wander does not oscillate
             self.wander_offset = heading;
         }
         let car = matches!(kin, Kinematics::Ackermann(_));
-        let slow = ((free - 0.3) / lookahead).clamp(0.0, 1.0);
+        // the robot moves along its CURRENT heading while it turns towards `heading`, so the
+        // speed is limited by the room straight ahead
+        let slow = ((ahead.min(free) - 0.35) / lookahead).clamp(0.0, 1.0);
         let mut v = self.speed * slow * heading.cos().max(0.0);
         if !car && heading.abs() > PI / 3.0 {
             v = 0.0; // turn in place first
         }
-        if car && v < 0.1 * self.speed {
+        if car && v < 0.1 * self.speed && ahead > 0.6 {
             v = 0.1 * self.speed; // a car must roll to turn
         }
         let w = (2.0 * heading).clamp(-self.max_yaw_rate, self.max_yaw_rate);
