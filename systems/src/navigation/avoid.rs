@@ -8,22 +8,20 @@ use crate::core::Pose2;
 use crate::sensors::LaserScan;
 use std::f64::consts::PI;
 
-pub const SECTORS: usize = 72;
+pub const SECTORS: usize = 180;
 const SECTOR_WIDTH: f64 = 2.0 * PI / SECTORS as f64;
 
-/// Minimum range per 5° sector in the robot's base frame (+Inf where nothing was seen).
+/// The nearest scan point per 2° sector around the robot, in its base frame.
 #[derive(Clone, Debug)]
 pub struct SectorRanges {
-    pub mins: [f32; SECTORS],
-    /// Whether each sector was covered by the laser at all.
-    pub seen: [bool; SECTORS],
+    /// (x, y) of the nearest point, or None where nothing was seen.
+    pub points: [Option<(f32, f32)>; SECTORS],
 }
 
 impl Default for SectorRanges {
     fn default() -> Self {
         SectorRanges {
-            mins: [f32::INFINITY; SECTORS],
-            seen: [false; SECTORS],
+            points: [None; SECTORS],
         }
     }
 }
@@ -33,56 +31,47 @@ fn sector_of(angle: f64) -> usize {
     ((a / SECTOR_WIDTH) as usize).min(SECTORS - 1)
 }
 
-fn sector_centre(s: usize) -> f64 {
-    -PI + (s as f64 + 0.5) * SECTOR_WIDTH
-}
-
 impl SectorRanges {
     pub fn from_scan(scan: &LaserScan, mount: &Pose2) -> Self {
         let mut out = SectorRanges::default();
+        let mut best = [f32::INFINITY; SECTORS];
         for (k, &r) in scan.ranges.iter().enumerate() {
-            let a = scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
             // a reading below range_min (-Inf) means something very close: treat it as range_min
             let r = if r == f32::NEG_INFINITY {
                 scan.range_min
             } else {
                 r
             };
+            if !r.is_finite() {
+                continue;
+            }
+            let a = scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
             let (s, c) = (a + mount.theta).sin_cos();
             let px = mount.x + c * r as f64;
             let py = mount.y + s * r as f64;
-            let idx = sector_of(if r.is_finite() {
-                py.atan2(px)
-            } else {
-                a + mount.theta
-            });
-            out.seen[idx] = true;
-            if r.is_finite() {
-                let d = px.hypot(py) as f32;
-                if d < out.mins[idx] {
-                    out.mins[idx] = d;
-                }
+            let idx = sector_of(py.atan2(px));
+            let d = px.hypot(py) as f32;
+            if d < best[idx] {
+                best[idx] = d;
+                out.points[idx] = Some((px as f32, py as f32));
             }
         }
         out
     }
 
-    /// Free distance along `heading` (base frame) for a body of half width `half_width`.
+    /// Free distance along `heading` (base frame) for a body of half width `half_width`: the
+    /// nearest seen point within the swept band.
     pub fn free_distance(&self, heading: f64, half_width: f64) -> f64 {
+        let (uy, ux) = heading.sin_cos();
         let mut free = f64::INFINITY;
-        for s in 0..SECTORS {
-            let r = self.mins[s] as f64;
-            if !r.is_finite() {
+        for &(x, y) in self.points.iter().flatten() {
+            let (x, y) = (x as f64, y as f64);
+            let along = x * ux + y * uy;
+            if along <= 0.0 {
                 continue;
             }
-            let d = crate::core::wrap_angle(sector_centre(s) - heading);
-            if d.abs() >= PI / 2.0 {
-                continue;
-            }
-            // the sector spans ±half a sector: use its closest edge to the heading
-            let d_edge = (d.abs() - SECTOR_WIDTH / 2.0).max(0.0);
-            if r * d_edge.sin() < half_width {
-                free = free.min(r * d_edge.cos());
+            if (x * uy - y * ux).abs() < half_width {
+                free = free.min(along);
             }
         }
         free
@@ -97,7 +86,7 @@ impl SectorRanges {
         needed: f64,
         max_dev: f64,
     ) -> (f64, f64) {
-        let step = SECTOR_WIDTH;
+        let step = 5f64.to_radians();
         let n = (max_dev / step).floor() as i32;
         let mut best_open = (wanted, self.free_distance(wanted, half_width));
         if best_open.1 >= needed {

@@ -82,8 +82,9 @@ impl Behaviour {
         self.status = NavStatus::Driving;
     }
 
-    /// Wanted heading relative to the robot (rad), or None when there is nothing to do.
-    fn wanted_bearing(&mut self, belief: &Pose2, now: f64) -> Option<f64> {
+    /// Wanted heading relative to the robot (rad) and the distance to the target (+Inf when
+    /// wandering), or None when there is nothing to do.
+    fn wanted_bearing(&mut self, belief: &Pose2, now: f64) -> Option<(f64, f64)> {
         match &self.kind {
             BehaviourKind::Idle => None,
             BehaviourKind::Waypoints { points, looping } => {
@@ -107,9 +108,9 @@ impl Behaviour {
                         self.reached += 1;
                         continue;
                     }
-                    return Some(wrap_angle(
-                        (p[1] - belief.y).atan2(p[0] - belief.x) - belief.theta,
-                    ));
+                    let bearing =
+                        wrap_angle((p[1] - belief.y).atan2(p[0] - belief.x) - belief.theta);
+                    return Some((bearing, d));
                 }
             }
             BehaviourKind::Wander => {
@@ -117,32 +118,35 @@ impl Behaviour {
                     self.wander_offset = self.rng.random_range(-PI / 3.0..PI / 3.0);
                     self.next_wander_change = now + self.rng.random_range(2.0..6.0);
                 }
-                Some(self.wander_offset * 0.5)
+                Some((self.wander_offset * 0.5, f64::INFINITY))
             }
         }
     }
 
     /// The drive command for this tick.
     pub fn command(&mut self, belief: &Pose2, now: f64, kin: &Kinematics) -> DriveCommand {
-        let Some(wanted) = self.wanted_bearing(belief, now) else {
+        let Some((wanted, goal_distance)) = self.wanted_bearing(belief, now) else {
             return DriveCommand::default();
         };
         let lookahead = 1.0 + self.speed;
+        // near a goal, only the way to the goal needs to be free (a waypoint just inside a
+        // furnished room must not send the robot looking for 1.8 m of open floor)
+        let needed = lookahead.min(goal_distance + 0.2);
         let (heading, free, ahead) = match &self.sectors {
             Some(s) => {
-                let (h, f) = s.choose_heading(wanted, self.half_width, lookahead, PI * 0.8);
+                let (h, f) = s.choose_heading(wanted, self.half_width, needed, PI * 0.8);
                 (h, f, s.free_distance(0.0, self.half_width))
             }
             None => (wanted, f64::INFINITY, f64::INFINITY),
         };
-        if matches!(self.kind, BehaviourKind::Wander) && free < lookahead {
+        if matches!(self.kind, BehaviourKind::Wander) && free < needed {
             // remember the way out so wander does not oscillate
             self.wander_offset = heading;
         }
         let car = matches!(kin, Kinematics::Ackermann(_));
         // the robot moves along its CURRENT heading while it turns towards `heading`, so the
         // speed is limited by the room straight ahead
-        let slow = ((ahead.min(free) - 0.35) / lookahead).clamp(0.0, 1.0);
+        let slow = ((ahead.min(free) - 0.35) / needed.max(0.5)).clamp(0.0, 1.0);
         let mut v = self.speed * slow * heading.cos().max(0.0);
         if !car && heading.abs() > PI / 3.0 {
             v = 0.0; // turn in place first

@@ -46,32 +46,6 @@ pub(crate) struct Walk {
 }
 
 impl Walk {
-    /// Starts a walk at parameter `t` (grid-relative origin gx, gy, cell size `res`).
-    pub fn start(gx: f32, gy: f32, dx: f32, dy: f32, res: f32, t: f32, w: usize, h: usize) -> Walk {
-        let px = gx + dx * t;
-        let py = gy + dy * t;
-        let cx = ((px / res).floor() as i32).clamp(0, w as i32 - 1);
-        let cy = ((py / res).floor() as i32).clamp(0, h as i32 - 1);
-        Walk::at_cell(gx, gy, dx, dy, res, t, cx, cy)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    pub fn at_cell(gx: f32, gy: f32, dx: f32, dy: f32, res: f32, t: f32, cx: i32, cy: i32) -> Walk {
-        let (sx, t_max_x, t_delta_x) = axis(gx, dx, res, cx);
-        let (sy, t_max_y, t_delta_y) = axis(gy, dy, res, cy);
-        Walk {
-            cx,
-            cy,
-            sx,
-            sy,
-            t_max_x,
-            t_max_y,
-            t_delta_x,
-            t_delta_y,
-            t,
-        }
-    }
-
     /// Moves into the next cell.
     #[inline(always)]
     pub fn step(&mut self) {
@@ -87,14 +61,83 @@ impl Walk {
     }
 }
 
-/// (step, first crossing time, crossing period) along one axis.
-fn axis(g: f32, d: f32, res: f32, c: i32) -> (i32, f32, f32) {
-    if d > 1e-12 {
-        (1, ((c + 1) as f32 * res - g) / d, res / d)
-    } else if d < -1e-12 {
-        (-1, (c as f32 * res - g) / d, -res / d)
-    } else {
-        (0, f32::INFINITY, f32::INFINITY)
+/// A ray's constants for restarting cell walks cheaply after leaps (no division, no floor).
+pub(crate) struct Ray {
+    gx: f32,
+    gy: f32,
+    dx: f32,
+    dy: f32,
+    res: f32,
+    inv_res: f32,
+    /// 1/dx, 1/dy (or +Inf) and the per-cell crossing periods.
+    idx: f32,
+    idy: f32,
+    sx: i32,
+    sy: i32,
+    tdx: f32,
+    tdy: f32,
+}
+
+impl Ray {
+    pub(crate) fn new(gx: f32, gy: f32, dx: f32, dy: f32, res: f32) -> Ray {
+        let inv = |d: f32| {
+            if d.abs() > 1e-12 {
+                1.0 / d
+            } else {
+                f32::INFINITY
+            }
+        };
+        let (idx, idy) = (inv(dx), inv(dy));
+        Ray {
+            gx,
+            gy,
+            dx,
+            dy,
+            res,
+            inv_res: 1.0 / res,
+            idx,
+            idy,
+            sx: if dx > 1e-12 {
+                1
+            } else if dx < -1e-12 {
+                -1
+            } else {
+                0
+            },
+            sy: if dy > 1e-12 {
+                1
+            } else if dy < -1e-12 {
+                -1
+            } else {
+                0
+            },
+            tdx: (res * idx).abs(),
+            tdy: (res * idy).abs(),
+        }
+    }
+
+    /// The walk state at parameter t (a point inside the grid, so coordinates are ≥ 0 and
+    /// truncation is floor).
+    #[inline(always)]
+    pub(crate) fn walk_at(&self, t: f32, w: i32, h: i32) -> Walk {
+        let cx = (((self.gx + self.dx * t) * self.inv_res) as i32).clamp(0, w - 1);
+        let cy = (((self.gy + self.dy * t) * self.inv_res) as i32).clamp(0, h - 1);
+        let next = |g: f32, s: i32, c: i32, inv: f32| match s {
+            1 => ((c + 1) as f32 * self.res - g) * inv,
+            -1 => (c as f32 * self.res - g) * inv,
+            _ => f32::INFINITY,
+        };
+        Walk {
+            cx,
+            cy,
+            sx: self.sx,
+            sy: self.sy,
+            t_max_x: next(self.gx, self.sx, cx, self.idx),
+            t_max_y: next(self.gy, self.sy, cy, self.idy),
+            t_delta_x: self.tdx,
+            t_delta_y: self.tdy,
+            t,
+        }
     }
 }
 
@@ -124,7 +167,7 @@ pub fn cast_dda(
     ) else {
         return f32::INFINITY;
     };
-    let mut walk = Walk::start(gx, gy, dx, dy, resolution, t0, width, height);
+    let mut walk = Ray::new(gx, gy, dx, dy, resolution).walk_at(t0, width as i32, height as i32);
     loop {
         if walk.cx < 0 || walk.cy < 0 || walk.cx >= width as i32 || walk.cy >= height as i32 {
             return f32::INFINITY;

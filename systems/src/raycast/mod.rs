@@ -16,6 +16,7 @@
 mod dda;
 mod overlay;
 mod raymap;
+mod sweep;
 
 pub use dda::cast_dda;
 pub use overlay::{overlay_circles, overlay_segments};

@@ -6,8 +6,15 @@ use std::f32::consts::{PI, TAU};
 
 /// Calls `f(k)` for every beam index k < n whose angle `start + k·inc` lies in the arc
 /// [lo, lo + width] (radians, any lo; width < 2π), handling wrap-around.
-fn beams_in_arc(start: f32, inc: f32, n: usize, lo: f32, width: f32, mut f: impl FnMut(usize)) {
-    let rel = (lo - start).rem_euclid(TAU);
+pub(crate) fn beams_in_arc(
+    start: f32,
+    inc: f32,
+    n: usize,
+    lo: f32,
+    width: f32,
+    mut f: impl FnMut(usize),
+) {
+    let rel = super::sweep::wrap_tau(lo - start);
     let span = (n.saturating_sub(1)) as f32 * inc;
     for shift in [0.0, -TAU] {
         let a = rel + shift;

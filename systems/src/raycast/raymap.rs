@@ -10,87 +10,8 @@
 //! around a ray share few cache lines; measured, memory latency — not arithmetic — dominates
 //! random rays on a row-major map.
 
-use super::dda::{Walk, enter_grid};
-
-/// A ray's constants for restarting cell walks cheaply after leaps (no division, no floor).
-struct Ray {
-    gx: f32,
-    gy: f32,
-    dx: f32,
-    dy: f32,
-    res: f32,
-    inv_res: f32,
-    /// 1/dx, 1/dy (or +Inf) and the per-cell crossing periods.
-    idx: f32,
-    idy: f32,
-    sx: i32,
-    sy: i32,
-    tdx: f32,
-    tdy: f32,
-}
-
-impl Ray {
-    fn new(gx: f32, gy: f32, dx: f32, dy: f32, res: f32) -> Ray {
-        let inv = |d: f32| {
-            if d.abs() > 1e-12 {
-                1.0 / d
-            } else {
-                f32::INFINITY
-            }
-        };
-        let (idx, idy) = (inv(dx), inv(dy));
-        Ray {
-            gx,
-            gy,
-            dx,
-            dy,
-            res,
-            inv_res: 1.0 / res,
-            idx,
-            idy,
-            sx: if dx > 1e-12 {
-                1
-            } else if dx < -1e-12 {
-                -1
-            } else {
-                0
-            },
-            sy: if dy > 1e-12 {
-                1
-            } else if dy < -1e-12 {
-                -1
-            } else {
-                0
-            },
-            tdx: (res * idx).abs(),
-            tdy: (res * idy).abs(),
-        }
-    }
-
-    /// The walk state at parameter t (a point inside the grid, so coordinates are ≥ 0 and
-    /// truncation is floor).
-    #[inline(always)]
-    fn walk_at(&self, t: f32, w: i32, h: i32) -> Walk {
-        let cx = (((self.gx + self.dx * t) * self.inv_res) as i32).clamp(0, w - 1);
-        let cy = (((self.gy + self.dy * t) * self.inv_res) as i32).clamp(0, h - 1);
-        let next = |g: f32, s: i32, c: i32, inv: f32| match s {
-            1 => ((c + 1) as f32 * self.res - g) * inv,
-            -1 => (c as f32 * self.res - g) * inv,
-            _ => f32::INFINITY,
-        };
-        Walk {
-            cx,
-            cy,
-            sx: self.sx,
-            sy: self.sy,
-            t_max_x: next(self.gx, self.sx, cx, self.idx),
-            t_max_y: next(self.gy, self.sy, cy, self.idy),
-            t_delta_x: self.tdx,
-            t_delta_y: self.tdy,
-            t,
-        }
-    }
-}
+use super::dda::{Ray, enter_grid};
+use super::sweep::{Faces, TILE as FACE_TILE};
 
 /// Distances are capped, so an edit only changes the field within this many cells.
 const CAP: u8 = 120;
@@ -105,6 +26,8 @@ pub struct RayMap {
     /// Tiles per row.
     tw: usize,
     dist: Vec<u8>,
+    /// Boundary faces per tile, for whole scans.
+    faces: Faces,
 }
 
 impl RayMap {
@@ -125,6 +48,7 @@ impl RayMap {
             origin,
             tw,
             dist: vec![CAP; tw * th * TILE * TILE],
+            faces: Faces::new(0, 0, resolution, &|_, _| false),
         };
         for r in 0..height {
             for c in 0..width {
@@ -135,7 +59,17 @@ impl RayMap {
             }
         }
         m.update(0, 0, width, height);
+        m.faces = Faces::new(width, height, resolution, &|c, r| m.occupied_at(c, r));
         m
+    }
+
+    /// Occupancy with signed indices; outside the grid is free.
+    fn occupied_at(&self, c: i64, r: i64) -> bool {
+        c >= 0
+            && r >= 0
+            && (c as usize) < self.w
+            && (r as usize) < self.h
+            && self.dist[self.idx(c as usize, r as usize)] == 0
     }
 
     #[inline(always)]
@@ -164,7 +98,7 @@ impl RayMap {
 
     /// Bytes used by the structure.
     pub fn memory_bytes(&self) -> usize {
-        self.dist.len()
+        self.dist.len() + self.faces.memory_bytes()
     }
 
     /// Local edit: sets cells and refreshes the distance field around them only.
@@ -182,6 +116,20 @@ impl RayMap {
             r1 = r1.max(r + 1);
         }
         if c0 < c1 {
+            // faces: the edited cells' tiles and their neighbours (a cell's faces look into them)
+            let (ftw, fth) = self.faces.tile_counts();
+            let tx0 = c0.saturating_sub(1) / FACE_TILE;
+            let ty0 = r0.saturating_sub(1) / FACE_TILE;
+            let tx1 = (c1 / FACE_TILE + 1).min(ftw);
+            let ty1 = (r1 / FACE_TILE + 1).min(fth);
+            let mut faces =
+                std::mem::replace(&mut self.faces, Faces::new(0, 0, self.res, &|_, _| false));
+            for ty in ty0..ty1 {
+                for tx in tx0..tx1 {
+                    faces.rebuild_tile(tx, ty, self.w, self.h, &|c, r| self.occupied_at(c, r));
+                }
+            }
+            self.faces = faces;
             let cap = CAP as usize;
             self.update(
                 c0.saturating_sub(cap),
@@ -300,8 +248,37 @@ impl RayMap {
         }
     }
 
-    /// A whole scan from one origin: beam k at `start + k·increment`.
+    /// A whole scan from one origin: beam k at `start + k·increment`. From a free cell inside the
+    /// grid this is the angular sweep over boundary faces; otherwise ray by ray.
     pub fn cast_scan(
+        &self,
+        p: [f32; 2],
+        start: f32,
+        increment: f32,
+        max_range: f32,
+        out: &mut [f32],
+    ) {
+        let gx = p[0] - self.origin[0];
+        let gy = p[1] - self.origin[1];
+        let inside = gx >= 0.0
+            && gy >= 0.0
+            && gx < self.w as f32 * self.res
+            && gy < self.h as f32 * self.res;
+        if inside {
+            let c = ((gx / self.res) as usize).min(self.w - 1);
+            let r = ((gy / self.res) as usize).min(self.h - 1);
+            if self.dist[self.idx(c, r)] == 0 {
+                out.iter_mut().for_each(|o| *o = 0.0);
+                return;
+            }
+            self.faces.scan(gx, gy, start, increment, max_range, out);
+            return;
+        }
+        self.cast_scan_rays(p, start, increment, max_range, out);
+    }
+
+    /// A whole scan ray by ray (the distance-field walk for every beam).
+    pub fn cast_scan_rays(
         &self,
         p: [f32; 2],
         start: f32,

@@ -202,6 +202,16 @@ fn edits_open_and_close_a_door() {
         let a = rng.f() * 2.0 * PI;
         assert!(agree(rm.cast(p, a, 20.0), m.dda(p, a, 20.0)));
     }
+    // whole scans (the face sweep) see the edit too
+    for _ in 0..20 {
+        let p = random_free_point(&m, &mut rng);
+        let mut out = vec![0.0; 720];
+        let inc = 2.0 * PI / 720.0;
+        rm.cast_scan(p, -PI, inc, 20.0, &mut out);
+        for (k, r) in out.iter().enumerate() {
+            assert!(agree(*r, m.dda(p, -PI + k as f32 * inc, 20.0)), "beam {k}");
+        }
+    }
     let open: Vec<(usize, usize, bool)> = (40..60).map(|r| (100, r, false)).collect();
     rm.set_cells(&open);
     assert!(rm.cast(p, 0.0, 20.0).is_infinite(), "open again");
