@@ -11,31 +11,27 @@ use std::f64::consts::PI;
 pub const SECTORS: usize = 180;
 const SECTOR_WIDTH: f64 = 2.0 * PI / SECTORS as f64;
 
-/// The nearest scan point per 2° sector around the robot, in its base frame.
-#[derive(Clone, Debug)]
+/// The nearest scan point of each 2° sector around the robot that saw something, in its base
+/// frame (a compact list: headings are tested against the points only).
+#[derive(Clone, Debug, Default)]
 pub struct SectorRanges {
-    /// (x, y) of the nearest point, or None where nothing was seen.
-    pub points: [Option<(f32, f32)>; SECTORS],
-}
-
-impl Default for SectorRanges {
-    fn default() -> Self {
-        SectorRanges {
-            points: [None; SECTORS],
-        }
-    }
-}
-
-fn sector_of(angle: f64) -> usize {
-    let a = crate::core::wrap_angle(angle) + PI; // (0, 2π]
-    ((a / SECTOR_WIDTH) as usize).min(SECTORS - 1)
+    pub points: Vec<(f32, f32)>,
 }
 
 impl SectorRanges {
     pub fn from_scan(scan: &LaserScan, mount: &Pose2) -> Self {
-        let mut out = SectorRanges::default();
         let mut best = [f32::INFINITY; SECTORS];
+        let mut nearest = [(0f32, 0f32); SECTORS];
+        // beam directions by rotation (no trigonometry per beam); points are binned by beam
+        // angle, while the free-distance test uses their exact coordinates
+        let a0 = scan.angle_min as f64 + mount.theta;
+        let inc = scan.angle_increment as f64;
+        let (si, ci) = inc.sin_cos();
+        let (mut s, mut c) = a0.sin_cos();
+        let bin = 1.0 / SECTOR_WIDTH;
         for (k, &r) in scan.ranges.iter().enumerate() {
+            let (sk, ck) = (s, c);
+            (s, c) = (s * ci + c * si, c * ci - s * si);
             // a reading below range_min (-Inf) means something very close: treat it as range_min
             let r = if r == f32::NEG_INFINITY {
                 scan.range_min
@@ -45,36 +41,38 @@ impl SectorRanges {
             if !r.is_finite() {
                 continue;
             }
-            let a = scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
-            let (s, c) = (a + mount.theta).sin_cos();
-            let px = mount.x + c * r as f64;
-            let py = mount.y + s * r as f64;
-            let idx = sector_of(py.atan2(px));
-            let d = px.hypot(py) as f32;
-            if d < best[idx] {
-                best[idx] = d;
-                out.points[idx] = Some((px as f32, py as f32));
+            let a = a0 + k as f64 * inc;
+            // shifted to be positive so truncation is floor (no libm call)
+            let idx = ((a + 5.0 * PI) * bin) as usize % SECTORS;
+            let px = (mount.x + ck * r as f64) as f32;
+            let py = (mount.y + sk * r as f64) as f32;
+            let d2 = px * px + py * py;
+            if d2 < best[idx] {
+                best[idx] = d2;
+                nearest[idx] = (px, py);
             }
         }
-        out
+        SectorRanges {
+            points: (0..SECTORS)
+                .filter(|&i| best[i].is_finite())
+                .map(|i| nearest[i])
+                .collect(),
+        }
     }
 
     /// Free distance along `heading` (base frame) for a body of half width `half_width`: the
     /// nearest seen point within the swept band.
     pub fn free_distance(&self, heading: f64, half_width: f64) -> f64 {
         let (uy, ux) = heading.sin_cos();
-        let mut free = f64::INFINITY;
-        for &(x, y) in self.points.iter().flatten() {
-            let (x, y) = (x as f64, y as f64);
+        let (ux, uy, hw) = (ux as f32, uy as f32, half_width as f32);
+        let mut free = f32::INFINITY;
+        for &(x, y) in &self.points {
             let along = x * ux + y * uy;
-            if along <= 0.0 {
-                continue;
-            }
-            if (x * uy - y * ux).abs() < half_width {
+            if along > 0.0 && (x * uy - y * ux).abs() < hw {
                 free = free.min(along);
             }
         }
-        free
+        free as f64
     }
 
     /// Among headings within ±`max_dev` of `wanted` (steps of 5°), the one closest to `wanted`

@@ -4,11 +4,12 @@
 
 use super::avoid::SectorRanges;
 use crate::body::{DriveCommand, Kinematics};
-use crate::core::{Pose2, SimClock, SimRng, wrap_angle};
+use crate::core::{KernelPool, Pose2, SimClock, SimRng, wrap_angle};
 use crate::localization::NavBelief;
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
 use rand::RngExt;
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -159,10 +160,12 @@ impl Behaviour {
     }
 }
 
-/// Control: every robot's behaviour produces its drive command.
+/// Control: every robot's behaviour produces its drive command, in parallel on the kernel pool
+/// (each behaviour draws only from its own random stream, so threads do not change results).
 #[allow(clippy::type_complexity)]
 pub fn drive_behaviours(
     clock: Res<SimClock>,
+    pool: Res<KernelPool>,
     mut robots: Query<(
         &mut Behaviour,
         &NavBelief,
@@ -172,14 +175,18 @@ pub fn drive_behaviours(
     )>,
 ) {
     let now = clock.start();
-    for (mut b, belief, kin, mut cmd, laser) in robots.iter_mut() {
-        if let Some((laser, scans)) = laser {
-            if let Some(scan) = scans.scans.last() {
-                b.sectors = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
-            } else if !laser.enabled {
-                b.sectors = None;
-            }
-        }
-        *cmd = b.command(&belief.pose, now, kin);
-    }
+    let mut jobs: Vec<_> = robots.iter_mut().collect();
+    pool.install(|| {
+        jobs.par_iter_mut()
+            .for_each(|(b, belief, kin, cmd, laser)| {
+                if let Some((laser, scans)) = laser {
+                    if let Some(scan) = scans.scans.last() {
+                        b.sectors = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+                    } else if !laser.enabled {
+                        b.sectors = None;
+                    }
+                }
+                **cmd = b.command(&belief.pose, now, kin);
+            });
+    });
 }

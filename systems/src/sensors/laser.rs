@@ -148,10 +148,16 @@ pub struct LaserTruth {
 pub fn apply_noise(spec: &LaserSpec, rng: &mut SimRng, ranges: &mut [f32]) {
     let max = spec.max_range as f32;
     let min = spec.min_range as f32;
+    // draw the same numbers for every beam, whatever it hit, so the stream's use does not
+    // depend on the geometry (which draws are made depends only on the laser's parameters)
+    let (draw_drop, draw_noise) = (spec.dropout > 0.0, spec.noise_std > 0.0);
     for r in ranges.iter_mut() {
-        // draw both numbers for every beam so the stream's use does not depend on the geometry
-        let drop: f64 = rng.random();
-        let n: f64 = rng.sample(StandardNormal);
+        let drop: f64 = if draw_drop { rng.random() } else { 1.0 };
+        let n: f64 = if draw_noise {
+            rng.sample(StandardNormal)
+        } else {
+            0.0
+        };
         if drop < spec.dropout || !r.is_finite() || *r > max {
             *r = f32::INFINITY;
             continue;
