@@ -214,6 +214,11 @@ impl Faces {
         // next tiles, the scan is complete
         let mut horizon = max_range;
         let mut visited = 0u32;
+        // a scan of at most 180° sees nothing wholly behind the line through the sensor across
+        // its central direction
+        let span = n.saturating_sub(1) as f32 * inc;
+        let (my, mx) = (start + span / 2.0).sin_cos();
+        let half_plane = span <= std::f32::consts::PI + 1e-6;
         for &(ox, oy, d) in &self.offsets {
             if d - 2.0 * half_diag > horizon {
                 break;
@@ -229,6 +234,9 @@ impl Faces {
             // occlusion: skip the tile if every beam crossing it already hit something nearer
             let cx = (tx as f32 + 0.5) * tsize - gx;
             let cy = (ty as f32 + 0.5) * tsize - gy;
+            if half_plane && cx * mx + cy * my < -half_diag {
+                continue;
+            }
             let dist = (cx * cx + cy * cy).sqrt();
             let near = dist - half_diag;
             if near > max_range {
