@@ -3,6 +3,7 @@
 
 mod common;
 mod determinism;
+mod events;
 mod physics;
 mod recording;
 mod scenarios;
