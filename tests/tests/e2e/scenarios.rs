@@ -170,3 +170,27 @@ fn places_resolve_from_the_map_places_file() {
     let s = load_scenario(&bundled("hospital_patrol")).unwrap();
     assert!(s.places.contains_key("pharmacy"), "{:?}", s.places.keys());
 }
+
+/// The bundled patrol really patrols: every robot keeps reaching its waypoints (a renamed place
+/// or a stuck behaviour shows up here) with few collisions.
+#[test]
+fn hospital_patrol_robots_make_progress() {
+    use sim::{RunOptions, run_scenario};
+    for seed in [0, 1] {
+        let mut s = load_scenario(&bundled("hospital_patrol")).unwrap();
+        s.seed = seed;
+        let out = run_scenario(
+            &s,
+            &RunOptions {
+                threads: 2,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        for r in &out.summary.robots {
+            assert!(r.waypoints_reached >= 5, "seed {seed}: {r:?}");
+            assert!(r.collisions <= 3, "seed {seed}: {r:?}");
+            assert!(r.distance_m > 40.0, "seed {seed}: {r:?}");
+        }
+    }
+}
