@@ -4,6 +4,33 @@
 
 use std::f32::consts::{PI, TAU};
 
+/// The beam indices k < n whose angle `start + k·inc` lies in the arc [lo, lo + width] (radians,
+/// any lo; width < 2π): at most two index ranges, because the arc may wrap past the scan's start.
+pub(crate) fn arc_beams(
+    start: f32,
+    inc: f32,
+    n: usize,
+    lo: f32,
+    width: f32,
+) -> [Option<std::ops::RangeInclusive<usize>>; 2] {
+    let rel = super::sweep::wrap_tau(lo - start);
+    let span = n.saturating_sub(1) as f32 * inc;
+    [0.0, -TAU].map(|shift| {
+        let a = rel + shift;
+        let b = a + width;
+        if b < 0.0 || a > span + 1e-6 {
+            return None;
+        }
+        let k0 = (a / inc).ceil().max(0.0) as usize;
+        let k1 = ((b / inc).floor() as isize).min(n as isize - 1);
+        if k1 >= k0 as isize {
+            Some(k0..=k1 as usize)
+        } else {
+            None
+        }
+    })
+}
+
 /// Calls `f(k)` for every beam index k < n whose angle `start + k·inc` lies in the arc
 /// [lo, lo + width] (radians, any lo; width < 2π), handling wrap-around.
 pub(crate) fn beams_in_arc(
@@ -14,22 +41,8 @@ pub(crate) fn beams_in_arc(
     width: f32,
     mut f: impl FnMut(usize),
 ) {
-    let rel = super::sweep::wrap_tau(lo - start);
-    let span = (n.saturating_sub(1)) as f32 * inc;
-    for shift in [0.0, -TAU] {
-        let a = rel + shift;
-        let b = a + width;
-        if b < 0.0 || a > span + 1e-6 {
-            continue;
-        }
-        let k0 = (a / inc).ceil().max(0.0) as usize;
-        let k1 = ((b / inc).floor() as isize).min(n as isize - 1);
-        if k1 < 0 {
-            continue;
-        }
-        for k in k0..=k1 as usize {
-            f(k);
-        }
+    for range in arc_beams(start, inc, n, lo, width).into_iter().flatten() {
+        range.for_each(&mut f);
     }
 }
 

@@ -6,7 +6,7 @@
 //! is entered through such a face, so results agree with the cell walk of [`super::cast_dda`].
 //! Cost grows with the faces actually visible, not with the length of the rays.
 
-use super::overlay::beams_in_arc;
+use super::overlay::{arc_beams, beams_in_arc};
 
 pub(crate) const TILE: usize = 16;
 
@@ -48,23 +48,10 @@ pub(crate) fn wrap_tau(mut a: f32) -> f32 {
 
 /// Whether any beam in the arc [lo, lo + width] has a range beyond `near`.
 fn any_beyond(start: f32, inc: f32, out: &[f32], lo: f32, width: f32, near: f32) -> bool {
-    use std::f32::consts::TAU;
-    let n = out.len();
-    let rel = wrap_tau(lo - start);
-    let span = n.saturating_sub(1) as f32 * inc;
-    for shift in [0.0, -TAU] {
-        let a = rel + shift;
-        let b = a + width;
-        if b < 0.0 || a > span + 1e-6 {
-            continue;
-        }
-        let k0 = (a / inc).ceil().max(0.0) as usize;
-        let k1 = ((b / inc).floor() as isize).min(n as isize - 1);
-        if k1 >= k0 as isize && out[k0..=k1 as usize].iter().any(|&r| r > near) {
-            return true;
-        }
-    }
-    false
+    arc_beams(start, inc, out.len(), lo, width)
+        .into_iter()
+        .flatten()
+        .any(|r| out[r].iter().any(|&x| x > near))
 }
 
 /// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`.
