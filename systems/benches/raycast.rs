@@ -67,6 +67,13 @@ fn bench(c: &mut Criterion) {
                 black_box(acc)
             })
         });
+        let mut out = vec![0f32; s.poses.len()];
+        g.bench_function(BenchmarkId::new("raymap_batch", s.name), |b| {
+            b.iter(|| {
+                s.map.cast_many(&s.poses, 20.0, &mut out);
+                black_box(out.iter().map(|r| r.min(20.0)).sum::<f32>())
+            })
+        });
         let gr = &s.grid;
         g.bench_function(BenchmarkId::new("dda", s.name), |b| {
             b.iter(|| {

@@ -28,10 +28,20 @@ impl SectorRanges {
         let inc = scan.angle_increment as f64;
         let (si, ci) = inc.sin_cos();
         let (mut s, mut c) = a0.sin_cos();
-        let bin = 1.0 / SECTOR_WIDTH;
-        for (k, &r) in scan.ranges.iter().enumerate() {
+        // the sector index as a running value in [0, SECTORS): no division per beam
+        let n = SECTORS as f64;
+        let mut q = ((a0 / SECTOR_WIDTH) % n + n) % n;
+        let dq = inc / SECTOR_WIDTH;
+        for &r in &scan.ranges {
             let (sk, ck) = (s, c);
             (s, c) = (s * ci + c * si, c * ci - s * si);
+            let idx = (q as usize).min(SECTORS - 1);
+            q += dq;
+            if q >= n {
+                q -= n;
+            } else if q < 0.0 {
+                q += n;
+            }
             // a reading below range_min (-Inf) means something very close: treat it as range_min
             let r = if r == f32::NEG_INFINITY {
                 scan.range_min
@@ -41,9 +51,6 @@ impl SectorRanges {
             if !r.is_finite() {
                 continue;
             }
-            let a = a0 + k as f64 * inc;
-            // shifted to be positive so truncation is floor (no libm call)
-            let idx = ((a + 5.0 * PI) * bin) as usize % SECTORS;
             let px = (mount.x + ck * r as f64) as f32;
             let py = (mount.y + sk * r as f64) as f32;
             let d2 = px * px + py * py;

@@ -2,21 +2,24 @@
 //! slices.
 //!
 //! - [`cast_dda`]: the reference, a plain Amanatides & Woo (1987) cell walk.
-//! - [`RayMap`]: the same exact walk, accelerated with a two-level grid: the fine walk runs only
-//!   inside 8 × 8-cell blocks near obstacles, and a coarse Chebyshev distance field (in blocks)
-//!   lets a ray leap across open space. Results are identical to [`cast_dda`] (every crossing
-//!   time is computed from the ray's origin, never accumulated), edits (doors) only touch block
-//!   flags and re-run a small breadth-first pass.
+//! - [`RayMap`]: the static map as a one-byte Chebyshev distance field (rays leap across open
+//!   space and walk cell by cell only next to obstacles) plus the boundary faces of occupied
+//!   cells per tile. `cast` is one ray, `cast_many` many independent rays advanced in turn so
+//!   their memory loads overlap, and `cast_scan` a whole scan by an angular sweep over the faces
+//!   (front to back, skipping hidden tiles). Results agree with [`cast_dda`]; edits (doors)
+//!   refresh the field and the faces locally.
 //! - [`overlay_circles`], [`overlay_segments`]: moving obstacles (other robots) drawn into an
 //!   already-cast scan, touching only the beams inside each obstacle's angular interval.
 //!
 //! Conventions: f32 metres and radians; row 0 is the bottom row; outside the grid is free; a ray
 //! starting in an occupied cell returns 0; no hit within `max_range` returns `f32::INFINITY`.
 
+mod batch;
 mod dda;
+mod fan;
 mod overlay;
 mod raymap;
-mod sweep;
+pub mod sweep;
 
 pub use dda::cast_dda;
 pub use overlay::{overlay_circles, overlay_segments};

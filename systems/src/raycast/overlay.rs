@@ -2,49 +2,8 @@
 //! beam-index interval it subtends from the sensor, and only those beams are intersected, so the
 //! cost is proportional to the beams actually covered.
 
+use super::fan::Fan;
 use std::f32::consts::{PI, TAU};
-
-/// The beam indices k < n whose angle `start + k·inc` lies in the arc [lo, lo + width] (radians,
-/// any lo; width < 2π): at most two index ranges, because the arc may wrap past the scan's start.
-pub(crate) fn arc_beams(
-    start: f32,
-    inc: f32,
-    n: usize,
-    lo: f32,
-    width: f32,
-) -> [Option<std::ops::RangeInclusive<usize>>; 2] {
-    let rel = super::sweep::wrap_tau(lo - start);
-    let span = n.saturating_sub(1) as f32 * inc;
-    [0.0, -TAU].map(|shift| {
-        let a = rel + shift;
-        let b = a + width;
-        if b < 0.0 || a > span + 1e-6 {
-            return None;
-        }
-        let k0 = (a / inc).ceil().max(0.0) as usize;
-        let k1 = ((b / inc).floor() as isize).min(n as isize - 1);
-        if k1 >= k0 as isize {
-            Some(k0..=k1 as usize)
-        } else {
-            None
-        }
-    })
-}
-
-/// Calls `f(k)` for every beam index k < n whose angle `start + k·inc` lies in the arc
-/// [lo, lo + width] (radians, any lo; width < 2π), handling wrap-around.
-pub(crate) fn beams_in_arc(
-    start: f32,
-    inc: f32,
-    n: usize,
-    lo: f32,
-    width: f32,
-    mut f: impl FnMut(usize),
-) {
-    for range in arc_beams(start, inc, n, lo, width).into_iter().flatten() {
-        range.for_each(&mut f);
-    }
-}
 
 /// Circles (cx, cy, radius): out[k] = min(out[k], distance to the circle along beam k). A sensor
 /// inside a circle sees 0 on every beam.
@@ -55,7 +14,7 @@ pub fn overlay_circles(
     out: &mut [f32],
     circles: &[[f32; 3]],
 ) {
-    let n = out.len();
+    let fan = Fan::new(start, increment, out.len());
     for &[cx, cy, r] in circles {
         let (vx, vy) = (cx - p[0], cy - p[1]);
         let d2 = vx * vx + vy * vy;
@@ -67,7 +26,7 @@ pub fn overlay_circles(
         let half = (r / d).asin();
         let centre = vy.atan2(vx);
         let c = d2 - r * r;
-        beams_in_arc(start, increment, n, centre - half, 2.0 * half, |k| {
+        fan.for_each_in(centre - half, 2.0 * half, |k| {
             let (sy, sx) = (start + k as f32 * increment).sin_cos();
             let b = sx * vx + sy * vy;
             let disc = b * b - c;
@@ -89,7 +48,7 @@ pub fn overlay_segments(
     out: &mut [f32],
     segments: &[[f32; 4]],
 ) {
-    let n = out.len();
+    let fan = Fan::new(start, increment, out.len());
     for &[x0, y0, x1, y1] in segments {
         let (ax, ay) = (x0 - p[0], y0 - p[1]);
         let (bx, by) = (x1 - p[0], y1 - p[1]);
@@ -103,7 +62,7 @@ pub fn overlay_segments(
         }
         let (lo, width) = if diff >= 0.0 { (a0, diff) } else { (a1, -diff) };
         let (ex, ey) = (bx - ax, by - ay);
-        beams_in_arc(start, increment, n, lo - 1e-6, width + 2e-6, |k| {
+        fan.for_each_in(lo - 1e-6, width + 2e-6, |k| {
             let (sy, sx) = (start + k as f32 * increment).sin_cos();
             // solve t·s = a + u·e for t ≥ 0, u ∈ [0, 1]
             let den = sx * ey - sy * ex;

@@ -73,10 +73,15 @@ impl RayMap {
     }
 
     #[inline(always)]
-    fn idx(&self, c: usize, r: usize) -> usize {
+    pub(super) fn idx(&self, c: usize, r: usize) -> usize {
         (((r >> TILE_SHIFT) * self.tw + (c >> TILE_SHIFT)) << (2 * TILE_SHIFT))
             + ((r & (TILE - 1)) << TILE_SHIFT)
             + (c & (TILE - 1))
+    }
+
+    /// The distance field in tiled order (see [`RayMap::idx`]).
+    pub(super) fn dist(&self) -> &[u8] {
+        &self.dist
     }
 
     pub fn width(&self) -> usize {
@@ -271,13 +276,15 @@ impl RayMap {
                 out.iter_mut().for_each(|o| *o = 0.0);
                 return;
             }
-            self.faces.scan(gx, gy, start, increment, max_range, out);
-            return;
+            if max_range <= self.faces.reach() {
+                self.faces.scan(gx, gy, start, increment, max_range, out);
+                return;
+            }
         }
         self.cast_scan_rays(p, start, increment, max_range, out);
     }
 
-    /// A whole scan ray by ray (the distance-field walk for every beam).
+    /// A whole scan ray by ray (the distance-field walk for every beam, several at a time).
     pub fn cast_scan_rays(
         &self,
         p: [f32; 2],
@@ -286,17 +293,15 @@ impl RayMap {
         max_range: f32,
         out: &mut [f32],
     ) {
-        // rotate the direction incrementally, re-anchored every 64 beams
-        let (si, ci) = increment.sin_cos();
-        let (mut dy, mut dx) = start.sin_cos();
-        for (k, o) in out.iter_mut().enumerate() {
-            if k % 64 == 0 {
-                (dy, dx) = (start + k as f32 * increment).sin_cos();
-            }
-            *o = self.cast_dir(p, dx, dy, max_range);
-            let nx = dx * ci - dy * si;
-            dy = dx * si + dy * ci;
-            dx = nx;
-        }
+        let n = out.len();
+        self.cast_stream(
+            n,
+            |k| {
+                let (dy, dx) = (start + k as f32 * increment).sin_cos();
+                (p, dx, dy)
+            },
+            max_range,
+            out,
+        );
     }
 }

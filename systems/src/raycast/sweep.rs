@@ -1,14 +1,19 @@
 //! Whole scans by angular rasterisation ("z-buffering" in polar coordinates): the boundary faces
 //! of occupied cells are precomputed per 16 × 16-cell tile (merged along straight runs); a scan
-//! visits the tiles within range front to back, skips tiles that the beams already hitting
-//! nearer cannot see past, culls back faces, maps each face to the beam indices it subtends and
+//! visits 4 × 4 groups of tiles (super tiles) within range front to back, skips groups and then
+//! tiles that the beams already hitting nearer cannot see past (tested against per-block maxima
+//! of the ranges so far, 16 beams a block), culls back faces, maps each face to the beam indices it subtends and
 //! keeps, per beam, the nearest exact ray–face intersection. The first occupied cell a ray enters
 //! is entered through such a face, so results agree with the cell walk of [`super::cast_dda`].
 //! Cost grows with the faces actually visible, not with the length of the rays.
 
-use super::overlay::{arc_beams, beams_in_arc};
+use super::fan::Fan;
 
 pub(crate) const TILE: usize = 16;
+/// Tiles per side of a super tile: empty or hidden regions are skipped 4 × 4 tiles at a time.
+const SUPER: usize = 4;
+/// Offsets are tabulated to this many super tiles (64 × 16 × SUPER cells, 205 m at 5 cm).
+const SUPER_RADIUS: i32 = 64;
 
 /// atan2 by a minimax polynomial (max error about 1e-5 rad): beam ranges are taken with a 1e-4
 /// rad margin and every hit is then computed exactly, so the approximation never changes a range.
@@ -33,25 +38,58 @@ fn fast_atan2(y: f32, x: f32) -> f32 {
     if y < 0.0 { -r } else { r }
 }
 
-/// Wraps an angle to [0, 2π) (arguments are within a few turns: no libm fmod).
-#[inline]
-pub(crate) fn wrap_tau(mut a: f32) -> f32 {
-    use std::f32::consts::TAU;
-    while a < 0.0 {
-        a += TAU;
-    }
-    while a >= TAU {
-        a -= TAU;
-    }
-    a
+/// Beams per block of the occlusion maxima.
+const BLOCK: usize = 16;
+
+/// Per-thread scratch of a scan: beam directions with their reciprocals and, per block of
+/// `BLOCK` beams, an upper bound of their ranges (exact after a refresh, stale-high in between:
+/// never too low).
+#[derive(Default)]
+struct Scratch {
+    dirs: Vec<[f32; 4]>,
+    bmax: Vec<f32>,
 }
 
-/// Whether any beam in the arc [lo, lo + width] has a range beyond `near`.
-fn any_beyond(start: f32, inc: f32, out: &[f32], lo: f32, width: f32, near: f32) -> bool {
-    arc_beams(start, inc, out.len(), lo, width)
-        .into_iter()
-        .flatten()
-        .any(|r| out[r].iter().any(|&x| x > near))
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// Whether any beam in the arc [lo, lo + width] has a range beyond `near`: blocks whose bound is
+/// not beyond are skipped whole, the others are checked beam by beam.
+fn any_beyond(fan: &Fan, out: &[f32], bmax: &[f32], lo: f32, width: f32, near: f32) -> bool {
+    fan.ranges(lo, width).into_iter().flatten().any(|(k0, k1)| {
+        (k0 / BLOCK..=k1 / BLOCK).any(|b| {
+            bmax[b] > near
+                && out[(b * BLOCK).max(k0)..=(b * BLOCK + BLOCK - 1).min(k1)]
+                    .iter()
+                    .any(|&x| x > near)
+        })
+    })
+}
+
+/// Occlusion test of a square region (centre offset (cx, cy) from the sensor, half diagonal
+/// `half_diag`): None if every beam that can cross it already hit something nearer, otherwise
+/// the distance from the sensor to its nearest possible point. The sensor's own neighbourhood is
+/// always visible.
+#[inline]
+fn visible_arc(
+    fan: &Fan,
+    out: &[f32],
+    bmax: &[f32],
+    cx: f32,
+    cy: f32,
+    half_diag: f32,
+    inc: f32,
+) -> Option<f32> {
+    let dist = (cx * cx + cy * cy).sqrt();
+    let near = dist - half_diag;
+    if dist <= half_diag * 1.05 {
+        return Some(near);
+    }
+    // asin(x) ≤ x·π/2 on [0, 1]: a slightly wide, never narrow, interval
+    let half = (half_diag / dist).min(1.0) * std::f32::consts::FRAC_PI_2 + inc;
+    let lo = fast_atan2(cy, cx) - half;
+    any_beyond(fan, out, bmax, lo, 2.0 * half, near).then_some(near)
 }
 
 /// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`.
@@ -69,19 +107,30 @@ pub(crate) struct Faces {
     th: usize,
     res: f32,
     tiles: Vec<Vec<Face>>,
-    /// Tile offsets sorted by distance (for front-to-back visits).
-    offsets: Vec<(i32, i32, f32)>,
+    /// Whether a tile has faces (a compact array for skipping the empty ones).
+    nonempty: Vec<bool>,
+    /// Super tiles per row and column, and whether any of their tiles has faces.
+    sw: usize,
+    sh: usize,
+    super_nonempty: Vec<bool>,
+    /// Super-tile offsets sorted by distance (for front-to-back visits).
+    offsets: Vec<(i16, i16, f32)>,
 }
 
 impl Faces {
     pub fn new(w: usize, h: usize, res: f32, occ: &dyn Fn(i64, i64) -> bool) -> Faces {
         let tw = w.div_ceil(TILE).max(1);
         let th = h.div_ceil(TILE).max(1);
+        let (sw, sh) = (tw.div_ceil(SUPER), th.div_ceil(SUPER));
         let mut f = Faces {
             tw,
             th,
             res,
             tiles: vec![Vec::new(); tw * th],
+            nonempty: vec![false; tw * th],
+            sw,
+            sh,
+            super_nonempty: vec![false; sw * sh],
             offsets: Vec::new(),
         };
         for ty in 0..th {
@@ -89,15 +138,21 @@ impl Faces {
                 f.rebuild_tile(tx, ty, w, h, occ);
             }
         }
-        let r = 80i32;
+        let r = SUPER_RADIUS;
+        let size = (SUPER * TILE) as f32 * res;
         for dy in -r..=r {
             for dx in -r..=r {
-                let d = ((dx * dx + dy * dy) as f32).sqrt() * TILE as f32 * res;
-                f.offsets.push((dx, dy, d));
+                let d = ((dx * dx + dy * dy) as f32).sqrt() * size;
+                f.offsets.push((dx as i16, dy as i16, d));
             }
         }
         f.offsets.sort_by(|a, b| a.2.total_cmp(&b.2));
         f
+    }
+
+    /// The longest range a sweep handles (farther tiles are not tabulated).
+    pub fn reach(&self) -> f32 {
+        (SUPER_RADIUS - 1) as f32 * (SUPER * TILE) as f32 * self.res
     }
 
     /// Re-extracts the faces of the occupied cells of one tile.
@@ -161,7 +216,14 @@ impl Faces {
                 }
             }
         }
+        self.nonempty[ty * self.tw + tx] = !faces.is_empty();
         self.tiles[ty * self.tw + tx] = faces;
+        let (sx, sy) = (tx / SUPER, ty / SUPER);
+        self.super_nonempty[sy * self.sw + sx] =
+            (sy * SUPER..((sy + 1) * SUPER).min(self.th)).any(|y| {
+                (sx * SUPER..((sx + 1) * SUPER).min(self.tw))
+                    .any(|x| self.nonempty[y * self.tw + x])
+            });
     }
 
     pub fn tile_counts(&self) -> (usize, usize) {
@@ -173,75 +235,136 @@ impl Faces {
             .iter()
             .map(|t| t.capacity() * std::mem::size_of::<Face>() + 24)
             .sum::<usize>()
-            + self.offsets.len() * 12
+            + self.nonempty.len()
+            + self.super_nonempty.len()
+            + self.offsets.len() * 8
     }
 
-    /// The scan from grid-relative (gx, gy), origin known to be in a free cell: `out[k]` = range
-    /// of beam k, +Inf beyond `max_range`.
+    /// The scan from grid-relative (gx, gy), origin known to be in a free cell and `max_range`
+    /// within [`Faces::reach`]: `out[k]` = range of beam k, +Inf beyond `max_range`.
     pub fn scan(&self, gx: f32, gy: f32, start: f32, inc: f32, max_range: f32, out: &mut [f32]) {
+        SCRATCH.with_borrow_mut(|s| self.scan_with(s, gx, gy, start, inc, max_range, out));
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn scan_with(
+        &self,
+        scratch: &mut Scratch,
+        gx: f32,
+        gy: f32,
+        start: f32,
+        inc: f32,
+        max_range: f32,
+        out: &mut [f32],
+    ) {
         let n = out.len();
         out.iter_mut().for_each(|o| *o = f32::INFINITY);
+        if n == 0 {
+            return;
+        }
+        let fan = Fan::new(start, inc, n);
+        let Scratch { dirs, bmax } = scratch;
+        bmax.clear();
+        bmax.resize(n.div_ceil(BLOCK), f32::INFINITY);
         // beam directions by rotation, re-anchored every 64 beams
-        let mut dirs = Vec::with_capacity(n);
+        dirs.clear();
         let (si, ci) = inc.sin_cos();
         let (mut dy, mut dx) = (0.0f32, 1.0f32);
+        let recip = |d: f32| {
+            if d.abs() < 1e-12 {
+                f32::INFINITY
+            } else {
+                1.0 / d
+            }
+        };
         for k in 0..n {
             if k % 64 == 0 {
                 (dy, dx) = (start + k as f32 * inc).sin_cos();
             }
-            dirs.push((dx, dy));
+            dirs.push([dx, dy, recip(dx), recip(dy)]);
             let nx = dx * ci - dy * si;
             dy = dx * si + dy * ci;
             dx = nx;
         }
         let tsize = TILE as f32 * self.res;
+        let ssize = SUPER as f32 * tsize;
         let half_diag = tsize * std::f32::consts::FRAC_1_SQRT_2;
-        let (ptx, pty) = ((gx / tsize).floor() as i32, (gy / tsize).floor() as i32);
-        // tiles are visited front to back: once every beam has hit something nearer than the
-        // next tiles, the scan is complete
-        let mut horizon = max_range;
-        let mut visited = 0u32;
+        let super_half_diag = ssize * std::f32::consts::FRAC_1_SQRT_2;
+        let (psx, psy) = ((gx / ssize) as i32, (gy / ssize) as i32);
         // a scan of at most 180° sees nothing wholly behind the line through the sensor across
         // its central direction
-        let span = n.saturating_sub(1) as f32 * inc;
-        let (my, mx) = (start + span / 2.0).sin_cos();
-        let half_plane = span <= std::f32::consts::PI + 1e-6;
+        let (my, mx) = (start + fan.span() / 2.0).sin_cos();
+        let half_plane = fan.span() <= std::f32::consts::PI + 1e-6;
+        let behind = |cx: f32, cy: f32, hd: f32| half_plane && cx * mx + cy * my < -hd;
+        // super tiles are visited front to back: once every beam has hit something nearer than
+        // the next ones, the scan is complete
+        let mut horizon = max_range;
         for &(ox, oy, d) in &self.offsets {
-            if d - 2.0 * half_diag > horizon {
+            if d - 2.0 * super_half_diag > horizon {
                 break;
             }
-            let (tx, ty) = (ptx + ox, pty + oy);
-            if tx < 0 || ty < 0 || tx >= self.tw as i32 || ty >= self.th as i32 {
+            let (sx, sy) = (psx + ox as i32, psy + oy as i32);
+            if sx < 0 || sy < 0 || sx >= self.sw as i32 || sy >= self.sh as i32 {
                 continue;
             }
-            let faces = &self.tiles[ty as usize * self.tw + tx as usize];
-            if faces.is_empty() {
+            if !self.super_nonempty[sy as usize * self.sw + sx as usize] {
                 continue;
             }
-            // occlusion: skip the tile if every beam crossing it already hit something nearer
-            let cx = (tx as f32 + 0.5) * tsize - gx;
-            let cy = (ty as f32 + 0.5) * tsize - gy;
-            if half_plane && cx * mx + cy * my < -half_diag {
+            let cx = (sx as f32 + 0.5) * ssize - gx;
+            let cy = (sy as f32 + 0.5) * ssize - gy;
+            if behind(cx, cy, super_half_diag) {
                 continue;
             }
-            let dist = (cx * cx + cy * cy).sqrt();
-            let near = dist - half_diag;
-            if near > max_range {
-                continue;
+            match visible_arc(&fan, out, bmax, cx, cy, super_half_diag, inc) {
+                Some(near) if near <= max_range => {}
+                _ => continue,
             }
-            if dist > half_diag * 1.05 {
-                // asin(x) ≤ x·π/2 on [0, 1]: a slightly wide, never narrow, interval
-                let half = (half_diag / dist).min(1.0) * std::f32::consts::FRAC_PI_2 + inc;
-                if !any_beyond(start, inc, out, fast_atan2(cy, cx) - half, 2.0 * half, near) {
+            // its tiles, nearest corner first (the order only makes occlusion more effective)
+            let (x0, y0) = (sx as usize * SUPER, sy as usize * SUPER);
+            for j in 0..SUPER {
+                let ty = if cy >= 0.0 {
+                    y0 + j
+                } else {
+                    y0 + SUPER - 1 - j
+                };
+                if ty >= self.th {
                     continue;
                 }
-            }
-            for f in faces {
-                self.draw_face(f, gx, gy, start, inc, &dirs, out);
-            }
-            visited += 1;
-            if visited.is_multiple_of(32) {
-                horizon = out.iter().fold(0.0f32, |m, &r| m.max(r)).min(max_range);
+                for i in 0..SUPER {
+                    let tx = if cx >= 0.0 {
+                        x0 + i
+                    } else {
+                        x0 + SUPER - 1 - i
+                    };
+                    if tx >= self.tw {
+                        continue;
+                    }
+                    let t = ty * self.tw + tx;
+                    if !self.nonempty[t] {
+                        continue;
+                    }
+                    let tcx = (tx as f32 + 0.5) * tsize - gx;
+                    let tcy = (ty as f32 + 0.5) * tsize - gy;
+                    if behind(tcx, tcy, half_diag) {
+                        continue;
+                    }
+                    match visible_arc(&fan, out, bmax, tcx, tcy, half_diag, inc) {
+                        Some(near) if near <= max_range => {}
+                        _ => continue,
+                    }
+                    let (mut k0, mut k1) = (usize::MAX, 0);
+                    for f in &self.tiles[t] {
+                        self.draw_face(f, gx, gy, &fan, dirs, out, &mut k0, &mut k1);
+                    }
+                    if k0 <= k1 {
+                        // the touched beams' blocks get exact bounds again
+                        for b in k0 / BLOCK..=k1 / BLOCK {
+                            let end = (b * BLOCK + BLOCK).min(n);
+                            bmax[b] = out[b * BLOCK..end].iter().fold(0.0f32, |m, &x| m.max(x));
+                        }
+                        horizon = bmax.iter().fold(0.0f32, |m, &r| m.max(r)).min(max_range);
+                    }
+                }
             }
         }
         for o in out.iter_mut() {
@@ -251,6 +374,8 @@ impl Faces {
         }
     }
 
+    /// Intersects one face with the beams it subtends, keeping the nearest hit per beam; the
+    /// indices of beams it shortened widen [k0, k1].
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn draw_face(
@@ -258,10 +383,11 @@ impl Faces {
         f: &Face,
         gx: f32,
         gy: f32,
-        start: f32,
-        inc: f32,
-        dirs: &[(f32, f32)],
+        fan: &Fan,
+        dirs: &[[f32; 4]],
         out: &mut [f32],
+        k0: &mut usize,
+        k1: &mut usize,
     ) {
         let vertical = f.kind < 2;
         // back-face culling: the sensor must be on the face's free side
@@ -284,21 +410,20 @@ impl Faces {
             diff += std::f32::consts::TAU;
         }
         let (lo, width) = if diff >= 0.0 { (a0, diff) } else { (a1, -diff) };
-        let n = out.len();
         let (p_at, p_lo, p_hi) = if vertical { (ax, ay, by) } else { (ay, ax, bx) };
-        beams_in_arc(start, inc, n, lo - 1e-4, width + 2e-4, |k| {
-            let (dx, dy) = dirs[k];
-            let (da, db) = if vertical { (dx, dy) } else { (dy, dx) };
-            if da.abs() < 1e-12 {
+        // the perpendicular component and its reciprocal, the parallel one
+        let (ia, ib) = if vertical { (2, 1) } else { (3, 0) };
+        fan.for_each_in(lo - 1e-4, width + 2e-4, |k| {
+            let d = &dirs[k];
+            let t = p_at * d[ia];
+            if !(t >= 0.0 && t < out[k]) {
                 return;
             }
-            let t = p_at / da;
-            if t < 0.0 || t >= out[k] {
-                return;
-            }
-            let s = t * db;
+            let s = t * d[ib];
             if s >= p_lo && s <= p_hi {
                 out[k] = t;
+                *k0 = (*k0).min(k);
+                *k1 = (*k1).max(k);
             }
         });
     }

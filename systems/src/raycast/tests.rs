@@ -337,3 +337,68 @@ fn circles_and_segments_overlay_analytically() {
     overlay_circles([0.0, 0.0], 0.0, 0.1, &mut out, &[[0.1, 0.0, 0.3]]);
     assert!(out.iter().all(|r| *r == 0.0));
 }
+
+#[test]
+fn batched_rays_agree_with_the_cell_walk() {
+    let m = random_map(5);
+    let rm = m.raymap();
+    let mut rng = XorShift(11);
+    // free origins, and every fourth anywhere around the map: inside obstacles or outside it
+    let rays: Vec<([f32; 2], f32)> = (0..8000)
+        .map(|i| {
+            let p = if i % 4 == 0 {
+                [
+                    m.origin[0] - 4.0 + rng.f() * 28.0,
+                    m.origin[1] - 4.0 + rng.f() * 23.0,
+                ]
+            } else {
+                random_free_point(&m, &mut rng)
+            };
+            (p, rng.f() * 2.0 * PI - PI)
+        })
+        .collect();
+    let mut corners = 0;
+    for max in [0.3, 4.0, 40.0] {
+        let mut out = vec![-1.0; rays.len()];
+        rm.cast_many(&rays, max, &mut out);
+        for (&(p, a), &r) in rays.iter().zip(&out) {
+            assert!(
+                agree_or_corner(&m, p, a, max, r, &mut corners),
+                "ray from {p:?} at {a}: {r} vs {}",
+                m.dda(p, a, max)
+            );
+        }
+    }
+    assert!(corners <= 3, "{corners} corner cases");
+    rm.cast_many(&[], 5.0, &mut []);
+}
+
+#[test]
+fn scans_beyond_the_sweep_reach_or_from_outside_fall_back_to_rays() {
+    // 2 mm cells: the face sweep reaches about 8 m, so a 10 m scan goes ray by ray
+    let mut m = random_map(3);
+    m.res = 0.002;
+    let rm = m.raymap();
+    let mut rng = XorShift(5);
+    let n = 721;
+    let inc = PI / 360.0;
+    let mut out = vec![0.0; n];
+    let outside = [m.origin[0] - 0.5, m.origin[1] + 0.3];
+    let mut corners = 0;
+    for p in (0..20)
+        .map(|_| random_free_point(&m, &mut rng))
+        .chain([outside])
+    {
+        for max in [10.0, 2.0] {
+            rm.cast_scan(p, -PI, inc, max, &mut out);
+            for (k, r) in out.iter().enumerate() {
+                let a = -PI + k as f32 * inc;
+                assert!(
+                    agree_or_corner(&m, p, a, max, *r, &mut corners),
+                    "beam {k} from {p:?}: {r}"
+                );
+            }
+        }
+    }
+    assert!(corners <= 30, "{corners} corner cases");
+}

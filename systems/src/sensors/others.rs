@@ -22,7 +22,8 @@ pub struct RobotOutlines {
     circles: Vec<Option<[f32; 3]>>,
     polygons: Vec<Vec<[f32; 4]>>,
     centres: Vec<[f64; 3]>,
-    buckets: std::collections::HashMap<(i32, i32), Vec<u32>>,
+    /// Bucket → robots in it (a fast non-cryptographic hash: a scan looks up ~100 buckets).
+    buckets: rustc_hash::FxHashMap<(i32, i32), Vec<u32>>,
 }
 
 impl RobotOutlines {
@@ -68,7 +69,8 @@ impl RobotOutlines {
                 continue;
             }
             let c = self.centres[i as usize];
-            if (c[0] - x).hypot(c[1] - y) > range + c[2] {
+            let (dx, dy, reach) = (c[0] - x, c[1] - y, range + c[2]);
+            if dx * dx + dy * dy > reach * reach {
                 continue;
             }
             if let Some(circle) = self.circles[i as usize] {

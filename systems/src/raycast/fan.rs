@@ -1,0 +1,111 @@
+//! A scan's beams as a fan of angles `start + k·inc`, k < n: which beam indices an arc of
+//! directions covers. Shared by the face sweep and the moving-obstacle overlays; the reciprocal of
+//! the increment is taken once per scan, so mapping an arc costs two multiplications.
+
+use std::f32::consts::TAU;
+
+/// Wraps an angle to [0, 2π) (arguments are within a few turns: no libm fmod).
+#[inline]
+pub(crate) fn wrap_tau(mut a: f32) -> f32 {
+    while a < 0.0 {
+        a += TAU;
+    }
+    while a >= TAU {
+        a -= TAU;
+    }
+    a
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fan {
+    start: f32,
+    inv_inc: f32,
+    /// Angle of the last beam relative to the first.
+    span: f32,
+    n: usize,
+}
+
+impl Fan {
+    pub fn new(start: f32, inc: f32, n: usize) -> Fan {
+        Fan {
+            start,
+            inv_inc: 1.0 / inc,
+            span: n.saturating_sub(1) as f32 * inc,
+            n,
+        }
+    }
+
+    pub fn span(&self) -> f32 {
+        self.span
+    }
+
+    /// The beam indices whose angle lies in the arc [lo, lo + width] (radians, any lo;
+    /// width < 2π), as at most two inclusive ranges (k0, k1): the arc may wrap past the start.
+    #[inline]
+    pub fn ranges(&self, lo: f32, width: f32) -> [Option<(usize, usize)>; 2] {
+        if self.n == 0 {
+            return [None, None];
+        }
+        let rel = wrap_tau(lo - self.start);
+        let one = |a: f32| {
+            let b = a + width;
+            if b < 0.0 || a > self.span + 1e-6 {
+                return None;
+            }
+            // b ≥ 0, so truncation is floor; ceil by hand (no SSE4.1 rounding, libm is slow)
+            let k0 = if a <= 0.0 {
+                0
+            } else {
+                let q = a * self.inv_inc;
+                let i = q as usize;
+                i + ((i as f32) < q) as usize
+            };
+            let k1 = ((b * self.inv_inc) as usize).min(self.n - 1);
+            (k1 >= k0).then_some((k0, k1))
+        };
+        // the second range only exists when the arc crosses 2π back into the fan
+        let second = if rel + width >= TAU {
+            one(rel - TAU)
+        } else {
+            None
+        };
+        [one(rel), second]
+    }
+
+    /// Calls `f(k)` for every beam index whose angle lies in the arc [lo, lo + width].
+    #[inline]
+    pub fn for_each_in(&self, lo: f32, width: f32, mut f: impl FnMut(usize)) {
+        for (k0, k1) in self.ranges(lo, width).into_iter().flatten() {
+            (k0..=k1).for_each(&mut f);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f32::consts::PI;
+
+    #[test]
+    fn arcs_map_to_beam_ranges_with_wrap_around() {
+        // 360 beams, one per degree from -180°
+        let fan = Fan::new(-PI, PI / 180.0, 360);
+        let deg = |d: f32| d.to_radians();
+        assert_eq!(fan.ranges(deg(0.5), deg(2.0)), [Some((181, 182)), None]);
+        // an arc across ±180° covers the last beams and the first ones
+        assert_eq!(
+            fan.ranges(deg(178.5), deg(3.0)),
+            [Some((359, 359)), Some((0, 1))]
+        );
+        // an arc outside a narrow fan covers nothing
+        let narrow = Fan::new(0.0, deg(1.0), 91);
+        assert_eq!(narrow.ranges(deg(100.0), deg(50.0)), [None, None]);
+        let r = narrow.ranges(deg(-10.0), deg(12.5));
+        assert_eq!(r.into_iter().flatten().collect::<Vec<_>>(), vec![(0, 2)]);
+        // no beams, no ranges
+        assert_eq!(Fan::new(0.0, 0.1, 0).ranges(0.0, 1.0), [None, None]);
+        let mut seen = Vec::new();
+        fan.for_each_in(deg(-1.5), deg(2.0), |k| seen.push(k));
+        assert_eq!(seen, vec![179, 180]);
+    }
+}
