@@ -8,7 +8,7 @@
 //! This is what a particle filter needs (every particle's beams at once: the `calc_range_many`
 //! of range_libc, Walsh & Karaman 2018) and what scans fall back to when the sweep does not apply.
 
-use super::dda::enter_grid;
+use super::dda::{enter_grid, step_sign};
 use super::raymap::RayMap;
 
 /// Rays in flight. Eight is enough to hide an L2/L3 load behind the other lanes' arithmetic.
@@ -89,16 +89,7 @@ impl RayMap {
                         }
                     }
                 }
-                let sign = |d: f32| {
-                    if d > 1e-12 {
-                        1
-                    } else if d < -1e-12 {
-                        -1
-                    } else {
-                        0
-                    }
-                };
-                let (sx, sy) = (sign(dx), sign(dy));
+                let (sx, sy) = (step_sign(dx), step_sign(dy));
                 *lane = Lane {
                     gx,
                     gy,

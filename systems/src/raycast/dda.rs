@@ -61,6 +61,19 @@ impl Walk {
     }
 }
 
+/// The cell step (−1, 0 or +1) of a direction component; components within 1e-12 of zero never
+/// cross a cell boundary.
+#[inline]
+pub(crate) fn step_sign(d: f32) -> i32 {
+    if d > 1e-12 {
+        1
+    } else if d < -1e-12 {
+        -1
+    } else {
+        0
+    }
+}
+
 /// A ray's constants for restarting cell walks cheaply after leaps (no division, no floor).
 pub(crate) struct Ray {
     gx: f32,
@@ -97,20 +110,8 @@ impl Ray {
             inv_res: 1.0 / res,
             idx,
             idy,
-            sx: if dx > 1e-12 {
-                1
-            } else if dx < -1e-12 {
-                -1
-            } else {
-                0
-            },
-            sy: if dy > 1e-12 {
-                1
-            } else if dy < -1e-12 {
-                -1
-            } else {
-                0
-            },
+            sx: step_sign(dx),
+            sy: step_sign(dy),
             tdx: (res * idx).abs(),
             tdy: (res * idy).abs(),
         }

@@ -2,8 +2,8 @@
 //! of occupied cells are precomputed per 16 × 16-cell tile (merged along straight runs); a scan
 //! visits 4 × 4 groups of tiles (super tiles) within range front to back, skips groups and then
 //! tiles that the beams already hitting nearer cannot see past (tested against per-block maxima
-//! of the ranges so far, 16 beams a block), culls back faces, maps each face to the beam indices it subtends and
-//! keeps, per beam, the nearest exact ray–face intersection. The first occupied cell a ray enters
+//! of the ranges so far, 16 beams a block), culls back faces, maps each face to the beam indices
+//! it subtends and keeps, per beam, the nearest exact ray–face intersection. The first occupied cell a ray enters
 //! is entered through such a face, so results agree with the cell walk of [`super::cast_dda`].
 //! Cost grows with the faces actually visible, not with the length of the rays.
 
@@ -72,7 +72,7 @@ fn any_beyond(fan: &Fan, out: &[f32], bmax: &[f32], lo: f32, width: f32, near: f
 /// the distance from the sensor to its nearest possible point. The sensor's own neighbourhood is
 /// always visible.
 #[inline]
-fn visible_arc(
+fn visible(
     fan: &Fan,
     out: &[f32],
     bmax: &[f32],
@@ -150,9 +150,10 @@ impl Faces {
         f
     }
 
-    /// The longest range a sweep handles (farther tiles are not tabulated).
+    /// The longest range a sweep handles: every super tile that can hold a point within it
+    /// (centre up to range + one super-tile diagonal away) must be in the offset table.
     pub fn reach(&self) -> f32 {
-        (SUPER_RADIUS - 1) as f32 * (SUPER * TILE) as f32 * self.res
+        (SUPER_RADIUS - 2) as f32 * (SUPER * TILE) as f32 * self.res
     }
 
     /// Re-extracts the faces of the occupied cells of one tile.
@@ -315,7 +316,7 @@ impl Faces {
             if behind(cx, cy, super_half_diag) {
                 continue;
             }
-            match visible_arc(&fan, out, bmax, cx, cy, super_half_diag, inc) {
+            match visible(&fan, out, bmax, cx, cy, super_half_diag, inc) {
                 Some(near) if near <= max_range => {}
                 _ => continue,
             }
@@ -348,7 +349,7 @@ impl Faces {
                     if behind(tcx, tcy, half_diag) {
                         continue;
                     }
-                    match visible_arc(&fan, out, bmax, tcx, tcy, half_diag, inc) {
+                    match visible(&fan, out, bmax, tcx, tcy, half_diag, inc) {
                         Some(near) if near <= max_range => {}
                         _ => continue,
                     }
