@@ -1,7 +1,7 @@
 //! World building: a validated scenario becomes an ECS world (resources and one entity per robot)
 //! and the tick schedule composed from the feature plugins of `systems`.
 
-use crate::scenario::{RobotConfig, Scenario};
+use crate::scenario::{LocalizerKind, RobotConfig, Scenario};
 use crate::script::{EventQueue, fire_events};
 use bevy_ecs::prelude::*;
 use systems::body::{
@@ -10,8 +10,11 @@ use systems::body::{
 use systems::core::{
     KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimSet, new_schedule, stream_rng,
 };
-use systems::eval::{EvalPlugin, RobotMetrics};
-use systems::localization::{LocalizationPlugin, NavBelief, OdometryModel, WheelOdometry};
+use systems::eval::{EvalPlugin, LocalizationSamples, RobotMetrics};
+use systems::localization::{
+    Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, Mcl, NavBelief,
+    OdometryModel, WheelOdometry,
+};
 use systems::navigation::{Behaviour, NavigationPlugin};
 use systems::sensors::{Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin};
 use systems::world::StaticWorld;
@@ -46,6 +49,15 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
     let mut static_world = StaticWorld::new(scenario.grid.clone());
     let mut physics = Physics::new(&mut static_world, scenario.dt);
     world.insert_resource(static_world);
+    // the map localizers believe in: the floor plan as it is at the start
+    let field_max_dist = scenario
+        .robots
+        .iter()
+        .flat_map(|r| r.localizers.iter().filter_map(|l| l.field_max_dist()))
+        .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))));
+    if let Some(max_dist) = field_max_dist {
+        world.insert_resource(LocalizationMap::new(scenario.grid.clone(), max_dist));
+    }
 
     let mut robots = Vec::with_capacity(scenario.robots.len());
     for (i, r) in scenario.robots.iter().enumerate() {
@@ -143,5 +155,26 @@ fn spawn_robot(
             ),
         ));
     }
-    e.id()
+    let id = e.id();
+    if !r.localizers.is_empty() {
+        let items = {
+            let map = world.resource::<LocalizationMap>();
+            r.localizers
+                .iter()
+                .map(|l| {
+                    let rng = stream_rng(seed, &r.name, &format!("localizer/{}", l.name));
+                    let filter = match &l.kind {
+                        LocalizerKind::Mcl(c) => {
+                            Filter::Mcl(Box::new(Mcl::new(c.clone(), map, rng)))
+                        }
+                    };
+                    Localizer::new(l.name.clone(), filter)
+                })
+                .collect()
+        };
+        world
+            .entity_mut(id)
+            .insert((Localizers { items }, LocalizationSamples::default()));
+    }
+    id
 }

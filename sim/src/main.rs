@@ -44,6 +44,9 @@ enum Command {
         /// No progress bar and no table, only errors.
         #[arg(long)]
         quiet: bool,
+        /// Write ground truth and every localizer's estimates here in TUM format (for evo).
+        #[arg(long)]
+        trajectories: Option<PathBuf>,
     },
     /// List the bundled scenarios.
     Scenarios,
@@ -98,6 +101,7 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
             summary,
             threads,
             quiet,
+            trajectories,
         } => {
             let arg = scenario.unwrap_or_else(|| DEFAULT_SCENARIO.to_string());
             let path = find_scenario(&arg).ok_or_else(|| {
@@ -150,6 +154,16 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
                         "recording written to {} (open it with: rerun {})",
                         p.display(),
                         p.display()
+                    );
+                }
+            }
+            if let Some(dir) = &trajectories {
+                let files = sim::record::write_trajectories(dir, &out.localization)?;
+                if !quiet {
+                    println!(
+                        "{} trajectory files written to {}",
+                        files.len(),
+                        dir.display()
                     );
                 }
             }

@@ -11,7 +11,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 use systems::body::TruePose;
 use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
-use systems::eval::RobotMetrics;
+use systems::eval::{LocalizationSamples, LocalizerMetrics, RobotMetrics, Sample};
+use systems::localization::Localizers;
 use systems::navigation::{Behaviour, NavStatus};
 
 #[derive(Clone, Debug, Default)]
@@ -30,6 +31,16 @@ pub struct RunOutput {
     pub summary: Summary,
     /// (time, true pose of each robot in index order), if requested.
     pub trajectory: Vec<(f64, Vec<Pose2>)>,
+    /// Every robot's localizer estimates paired with the truth, in robot index order.
+    pub localization: Vec<RobotLocalization>,
+}
+
+/// The estimate/truth samples of one robot's localizers.
+#[derive(Clone, Debug)]
+pub struct RobotLocalization {
+    pub robot: String,
+    /// (localizer name, samples) in the order of the scenario.
+    pub localizers: Vec<(String, Vec<Sample>)>,
 }
 
 fn truth_poses(w: &mut World) -> Vec<Pose2> {
@@ -104,14 +115,40 @@ pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<Ru
     Ok(RunOutput {
         summary,
         trajectory,
+        localization: robot_localization(&mut sim.world),
     })
 }
 
 fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
-    let mut q = w.query::<(&RobotIndex, &RobotId, &TruePose, &RobotMetrics, &Behaviour)>();
+    let mut q = w.query::<(
+        &RobotIndex,
+        &RobotId,
+        &TruePose,
+        &RobotMetrics,
+        &Behaviour,
+        Option<(&Localizers, &LocalizationSamples)>,
+    )>();
     let mut rows: Vec<(RobotIndex, RobotSummary)> = q
         .iter(w)
-        .map(|(i, id, truth, m, b)| {
+        .map(|(i, id, truth, m, b, loc)| {
+            let localization = match loc {
+                Some((locs, samples)) => locs
+                    .items
+                    .iter()
+                    .map(|l| {
+                        let s = samples
+                            .per_localizer
+                            .iter()
+                            .find(|(n, _)| *n == l.name)
+                            .map_or(&[][..], |(_, s)| &s[..]);
+                        (
+                            l.name.clone(),
+                            LocalizerMetrics::from_samples(l.filter.kind(), s),
+                        )
+                    })
+                    .collect(),
+                None => Default::default(),
+            };
             let p = truth.pose;
             (
                 *i,
@@ -132,6 +169,25 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                     waypoints_reached: b.reached,
                     route_completed: b.status == NavStatus::Arrived,
                     final_pose: [p.x, p.y, p.theta],
+                    localization,
+                },
+            )
+        })
+        .collect();
+    rows.sort_by_key(|(i, _)| *i);
+    rows.into_iter().map(|(_, r)| r).collect()
+}
+
+fn robot_localization(w: &mut World) -> Vec<RobotLocalization> {
+    let mut q = w.query::<(&RobotIndex, &RobotId, &LocalizationSamples)>();
+    let mut rows: Vec<(RobotIndex, RobotLocalization)> = q
+        .iter(w)
+        .map(|(i, id, s)| {
+            (
+                *i,
+                RobotLocalization {
+                    robot: id.0.clone(),
+                    localizers: s.per_localizer.clone(),
                 },
             )
         })

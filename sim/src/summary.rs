@@ -1,6 +1,8 @@
 //! The run summary: printed as a table and written as JSON with `--summary`.
 
 use serde::Serialize;
+use std::collections::BTreeMap;
+use systems::eval::LocalizerMetrics;
 
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct Summary {
@@ -31,6 +33,8 @@ pub struct RobotSummary {
     pub route_completed: bool,
     /// Final true pose [x, y, yaw].
     pub final_pose: [f64; 3],
+    /// Accuracy of each localizer, by name.
+    pub localization: BTreeMap<String, LocalizerMetrics>,
 }
 
 impl Summary {
@@ -72,6 +76,43 @@ impl Summary {
                 r.odometry_drift_percent,
                 r.waypoints_reached
             );
+        }
+        let with_loc: Vec<&RobotSummary> = self
+            .robots
+            .iter()
+            .filter(|r| !r.localization.is_empty())
+            .collect();
+        if !with_loc.is_empty() {
+            s += &format!(
+                "\n{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9}\n",
+                "robot",
+                "localizer",
+                "estimates",
+                "ATE m",
+                "RPE m",
+                "RPE rad",
+                "converged s",
+                "tracked %"
+            );
+            let opt = |v: Option<f64>, prec: usize| match v {
+                Some(v) => format!("{v:.prec$}"),
+                None => "-".to_string(),
+            };
+            for r in with_loc {
+                for (name, m) in &r.localization {
+                    s += &format!(
+                        "{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9}\n",
+                        r.name,
+                        name,
+                        m.estimates,
+                        opt(m.ate_rmse_m, 3),
+                        opt(m.rpe_trans_m, 4),
+                        opt(m.rpe_rot_rad, 4),
+                        opt(m.converged_after_s, 1),
+                        opt(m.tracked_fraction.map(|f| 100.0 * f), 1),
+                    );
+                }
+            }
         }
         s
     }

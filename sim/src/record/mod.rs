@@ -1,5 +1,8 @@
-//! Recording: the Rerun .rrd file (always, unless disabled). MCAP replays come later.
+//! Recording: the Rerun .rrd file (always, unless disabled) and, on request, TUM trajectories of
+//! every localizer. MCAP replays come later.
 
 pub mod rrd;
+pub mod tum;
 
 pub use rrd::{RrdRecorder, record_rrd};
+pub use tum::write_trajectories;

@@ -80,6 +80,9 @@ pub struct RobotFile {
     pub kinematics: Option<KinematicsFile>,
     pub behaviour: Option<BehaviourFile>,
     pub sensors: Option<SensorsFile>,
+    /// Localizers (`[[robots.localization]]` tables or an inline array).
+    #[serde(default)]
+    pub localization: Vec<super::localizers::LocalizerFile>,
 }
 
 /// A point given as coordinates or as the name of a place.

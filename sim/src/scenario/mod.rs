@@ -5,10 +5,12 @@
 
 pub mod error;
 pub mod file;
+pub mod localizers;
 pub mod resolve;
 
 pub use error::ScenarioError;
 pub use file::SensorName;
+pub use localizers::{LocalizerConfig, LocalizerKind};
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -66,6 +68,7 @@ pub struct RobotConfig {
     pub tolerance: f64,
     pub laser: Option<LaserSpec>,
     pub encoder: Option<EncoderSpec>,
+    pub localizers: Vec<LocalizerConfig>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

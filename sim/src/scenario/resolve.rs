@@ -13,19 +13,19 @@ use systems::sensors::{EncoderSpec, LaserSpec};
 use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
 use systems::world::{OccupancyGrid, load_map};
 
-type R<T> = Result<T, ScenarioError>;
+pub(super) type R<T> = Result<T, ScenarioError>;
 
-struct Checker<'a> {
+pub(super) struct Checker<'a> {
     cx: ErrorContext<'a>,
 }
 
 impl Checker<'_> {
-    fn err<T>(&self, path: &KeyPath, msg: impl Into<String>) -> R<T> {
+    pub(super) fn err<T>(&self, path: &KeyPath, msg: impl Into<String>) -> R<T> {
         Err(self.cx.at(path, msg))
     }
 
     /// A finite number in [lo, hi] (either bound optional), `open_lo` excluding lo.
-    fn range(
+    pub(super) fn range(
         &self,
         path: &KeyPath,
         v: f64,
@@ -53,18 +53,18 @@ impl Checker<'_> {
         Ok(v)
     }
 
-    fn positive(&self, path: &KeyPath, v: f64) -> R<f64> {
+    pub(super) fn positive(&self, path: &KeyPath, v: f64) -> R<f64> {
         self.range(path, v, Some(0.0), None, true)
     }
 
-    fn opt_positive(&self, path: &KeyPath, v: Option<f64>, default: f64) -> R<f64> {
+    pub(super) fn opt_positive(&self, path: &KeyPath, v: Option<f64>, default: f64) -> R<f64> {
         match v {
             Some(v) => self.positive(path, v),
             None => Ok(default),
         }
     }
 
-    fn finite(&self, path: &KeyPath, vals: &[f64]) -> R<()> {
+    pub(super) fn finite(&self, path: &KeyPath, vals: &[f64]) -> R<()> {
         if vals.iter().any(|v| !v.is_finite()) {
             return self.err(path, format!("expected finite numbers, got {vals:?}"));
         }
@@ -72,7 +72,7 @@ impl Checker<'_> {
     }
 }
 
-fn check_name(name: &str) -> bool {
+pub(super) fn check_name(name: &str) -> bool {
     !name.is_empty()
         && name
             .chars()
@@ -335,6 +335,25 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             Some(e) => Some(resolve_encoder(&c, &sp.key("encoder"), e)?),
             None => None,
         };
+        let lp = p.key("localization");
+        let localizers = super::localizers::resolve_localizers(
+            &c,
+            &lp,
+            &r.localization,
+            &start,
+            &|path: &KeyPath, v: &PointOrPlace| {
+                let pose = point(path, v)?;
+                inside(path, &pose)?;
+                Ok(pose)
+            },
+        )?;
+        if !localizers.is_empty() && (laser.is_none() || encoder.is_none()) {
+            return c.err(
+                &lp,
+                "localizers read the laser and the wheel odometry: give the robot \
+                 `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
+            );
+        }
         if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
             return c.err(
                 &bp.key("type"),
@@ -351,6 +370,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             tolerance,
             laser,
             encoder,
+            localizers,
         });
     }
 

@@ -1,8 +1,17 @@
-//! Estimators: they read sensor readings only, never ground truth. For now: wheel odometry, which
-//! also provides the belief controllers navigate by.
+//! Estimators: they read sensor readings only, never ground truth. Wheel odometry (which also
+//! provides the belief controllers navigate by), the odometry motion model the filters share,
+//! the map localizers believe in, and the localizers themselves (Monte Carlo localization).
 
+pub mod localizer;
+pub mod map;
+pub mod mcl;
+pub mod motion_model;
 pub mod odometry;
 
+pub use localizer::{Filter, Localizer, Localizers, StampedEstimate};
+pub use map::LocalizationMap;
+pub use mcl::{Mcl, MclConfig, PoseEstimate};
+pub use motion_model::OdometryMotionModel;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};
 
 use crate::core::{SimPlugin, SimSet};
@@ -12,6 +21,51 @@ pub struct LocalizationPlugin;
 
 impl SimPlugin for LocalizationPlugin {
     fn build(&self, _world: &mut World, schedule: &mut Schedule) {
-        schedule.add_systems(odometry::integrate_odometry.in_set(SimSet::Estimate));
+        schedule.add_systems(
+            (odometry::integrate_odometry, localizer::run_localizers)
+                .chain()
+                .in_set(SimSet::Estimate),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::body::{TruePose, TrueTwist};
+    use crate::sensors::LaserTruth;
+    use bevy_ecs::prelude::*;
+    use bevy_ecs::system::SystemAccess;
+
+    /// The rule of ../shared/DESIGN.md: estimators never read ground truth. Their systems'
+    /// declared world access (what bevy lets them touch) contains no ground-truth component.
+    #[test]
+    fn localization_systems_never_read_ground_truth() {
+        let mut world = World::new();
+        let truth = [
+            world.register_component::<TruePose>(),
+            world.register_component::<TrueTwist>(),
+            world.register_component::<LaserTruth>(),
+        ];
+        let mut systems: Vec<Box<dyn System<In = (), Out = ()>>> = vec![
+            Box::new(IntoSystem::into_system(super::odometry::integrate_odometry)),
+            Box::new(IntoSystem::into_system(super::localizer::run_localizers)),
+        ];
+        for s in systems.iter_mut() {
+            match s.initialize(&mut world) {
+                SystemAccess::Shared(set) => {
+                    let access = set.combined_access();
+                    for id in truth {
+                        assert!(
+                            !access.has_read(id) && !access.has_write(id),
+                            "{} touches ground truth",
+                            s.name()
+                        );
+                    }
+                    // and they do read something (the test would be empty otherwise)
+                    assert!(access.has_any_read(), "{}", s.name());
+                }
+                other => panic!("{}: unexpected access {other:?}", s.name()),
+            }
+        }
     }
 }

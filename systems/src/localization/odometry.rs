@@ -29,6 +29,9 @@ pub struct WheelOdometry {
     pub pose: Pose2,
     pub stamp: f64,
     last: Option<(i64, i64)>,
+    /// The poses integrated this tick, after the last one of the previous tick (for
+    /// [`WheelOdometry::pose_at`]).
+    trail: Vec<(f64, Pose2)>,
 }
 
 impl WheelOdometry {
@@ -39,6 +42,7 @@ impl WheelOdometry {
             pose: start,
             stamp: 0.0,
             last: None,
+            trail: Vec::new(),
         }
     }
 
@@ -71,6 +75,29 @@ impl WheelOdometry {
         };
         self.pose = crate::body::kinematics::integrate_arc(&self.pose, ds, dth, 1.0);
         self.stamp = stamp;
+        self.trail.push((stamp, self.pose));
+    }
+
+    /// Keeps only the latest pose of the trail (called at the start of each tick).
+    fn start_tick(&mut self) {
+        let keep = self.trail.len().saturating_sub(1);
+        self.trail.drain(..keep);
+    }
+
+    /// The odometry pose at time `t` of the current tick: interpolated between readings, or
+    /// extrapolated from the last two (by at most one reading interval) after the last one.
+    pub fn pose_at(&self, t: f64) -> Pose2 {
+        let n = self.trail.len();
+        if n < 2 {
+            return self.pose;
+        }
+        let i = self.trail.partition_point(|(s, _)| *s < t).clamp(1, n - 1);
+        let ((t0, p0), (t1, p1)) = (self.trail[i - 1], self.trail[i]);
+        if t1 <= t0 {
+            return p1;
+        }
+        let f = ((t - t0) / (t1 - t0)).clamp(0.0, 2.0);
+        p0.lerp(&p1, f)
     }
 }
 
@@ -87,6 +114,7 @@ pub fn integrate_odometry(
     mut robots: Query<(&EncoderReadings, &mut WheelOdometry, Option<&mut NavBelief>)>,
 ) {
     for (readings, mut odom, belief) in robots.iter_mut() {
+        odom.start_tick();
         for r in &readings.readings {
             odom.update(r.left_ticks, r.right_ticks, r.steer, r.stamp);
         }
@@ -138,5 +166,24 @@ mod tests {
             o.update(i * 100, i * 100, 0.0, i as f64);
         }
         assert!(o.pose.theta > 0.05 && o.pose.y > 0.1, "{:?}", o.pose);
+    }
+
+    #[test]
+    fn pose_between_readings_is_interpolated() {
+        let model = OdometryModel::DiffDrive {
+            left_radius: 0.1,
+            right_radius: 0.1,
+            wheel_base: 0.5,
+        };
+        let mut o = WheelOdometry::new(model, 1000, Pose2::IDENTITY);
+        o.update(0, 0, 0.0, 0.0);
+        o.update(1000, 1000, 0.0, 0.02);
+        o.start_tick();
+        o.update(2000, 2000, 0.0, 0.04);
+        let step = TAU * 0.1;
+        assert!((o.pose_at(0.03).x - 1.5 * step).abs() < 1e-9);
+        // after the last reading: extrapolated, at most one interval ahead
+        assert!((o.pose_at(0.05).x - 2.5 * step).abs() < 1e-9);
+        assert!((o.pose_at(9.0).x - 3.0 * step).abs() < 1e-9);
     }
 }

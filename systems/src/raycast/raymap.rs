@@ -31,6 +31,17 @@ pub struct RayMap {
 }
 
 impl RayMap {
+    /// The ray map of an occupancy grid's obstacles.
+    pub fn from_grid(grid: &crate::world::OccupancyGrid) -> Self {
+        RayMap::new(
+            grid.width,
+            grid.height,
+            grid.resolution as f32,
+            [grid.origin[0] as f32, grid.origin[1] as f32],
+            &grid.obstacles(),
+        )
+    }
+
     pub fn new(
         width: usize,
         height: usize,

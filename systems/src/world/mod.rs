@@ -1,13 +1,16 @@
 //! The static environment: the occupancy grid (from ROS map_server files and/or vector shapes),
 //! its ray-casting structure and the tiles its physics colliders are built from. Local edits
-//! (doors) change the grid, the ray map and the affected collider tiles only.
+//! (doors) change the grid, the ray map and the affected collider tiles only. The Euclidean
+//! distance field localization weighs scans on lives here too.
 
+pub mod distance_field;
 pub mod grid;
 pub mod map_file;
 pub mod rects;
 pub mod shapes;
 pub mod static_world;
 
+pub use distance_field::DistanceField;
 pub use grid::{Cell, OccupancyGrid};
 pub use map_file::{MapError, load_map};
 pub use shapes::Shape;

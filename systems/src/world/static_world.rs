@@ -20,13 +20,7 @@ pub struct StaticWorld {
 
 impl StaticWorld {
     pub fn new(grid: OccupancyGrid) -> Self {
-        let rays = RayMap::new(
-            grid.width,
-            grid.height,
-            grid.resolution as f32,
-            [grid.origin[0] as f32, grid.origin[1] as f32],
-            &grid.obstacles(),
-        );
+        let rays = RayMap::from_grid(&grid);
         StaticWorld {
             grid,
             rays,

@@ -4,6 +4,7 @@
 mod common;
 mod determinism;
 mod events;
+mod localization;
 mod physics;
 mod recording;
 mod scenarios;

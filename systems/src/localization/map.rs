@@ -1,0 +1,84 @@
+//! The map localizers believe in: a snapshot of the static occupancy grid taken when the world is
+//! built (a localizer knows the floor plan, not where today's obstacles stand), with the
+//! structures the measurement models need: the Euclidean distance field (likelihood fields), the
+//! ray-casting map (beam models, expected scans) and the list of free cells (global
+//! initialisation and random particles). Edits go through [`LocalizationMap::set_cells`] so all
+//! views stay consistent.
+
+use crate::raycast::RayMap;
+use crate::world::{Cell, DistanceField, OccupancyGrid};
+use bevy_ecs::prelude::Resource;
+
+#[derive(Resource)]
+pub struct LocalizationMap {
+    pub grid: OccupancyGrid,
+    pub field: DistanceField,
+    pub rays: RayMap,
+    /// Indices of the free cells.
+    free: Vec<u32>,
+}
+
+impl LocalizationMap {
+    /// The map of `grid`, its distance field truncated at `max_dist` (m): the largest distance
+    /// any likelihood model using it needs.
+    pub fn new(grid: OccupancyGrid, max_dist: f64) -> Self {
+        let field = DistanceField::new(&grid, max_dist);
+        let rays = RayMap::from_grid(&grid);
+        let free = Self::free_cells(&grid);
+        LocalizationMap {
+            grid,
+            field,
+            rays,
+            free,
+        }
+    }
+
+    fn free_cells(grid: &OccupancyGrid) -> Vec<u32> {
+        (0..grid.cells.len() as u32)
+            .filter(|&i| grid.cells[i as usize] == Cell::Free)
+            .collect()
+    }
+
+    /// Number of free cells.
+    pub fn free_count(&self) -> usize {
+        self.free.len()
+    }
+
+    /// A pose uniform over free space with a uniform heading, from uniform draws in [0, 1).
+    /// With no free cell at all, a pose uniform over the whole grid.
+    pub fn random_free_pose(&self, u: &mut dyn FnMut() -> f64) -> (f64, f64, f64) {
+        let g = &self.grid;
+        let (c, r) = if self.free.is_empty() {
+            (u() * g.width as f64, u() * g.height as f64)
+        } else {
+            let k = ((u() * self.free.len() as f64) as usize).min(self.free.len() - 1);
+            let i = self.free[k] as usize;
+            ((i % g.width) as f64 + u(), (i / g.width) as f64 + u())
+        };
+        let th = (u() * 2.0 - 1.0) * std::f64::consts::PI;
+        (
+            g.origin[0] + c * g.resolution,
+            g.origin[1] + r * g.resolution,
+            th,
+        )
+    }
+
+    /// Local edit of the believed map (e.g. a door the robots are told about).
+    pub fn set_cells(&mut self, cells: &[(usize, usize, Cell)]) {
+        let mut changed = Vec::new();
+        let mut ray_edits = Vec::new();
+        for &(c, r, cell) in cells {
+            if c < self.grid.width && r < self.grid.height && self.grid.get(c, r) != cell {
+                self.grid.set(c, r, cell);
+                changed.push((c, r));
+                ray_edits.push((c, r, cell == Cell::Occupied));
+            }
+        }
+        if changed.is_empty() {
+            return;
+        }
+        self.field.update(&self.grid, &changed);
+        self.rays.set_cells(&ray_edits);
+        self.free = Self::free_cells(&self.grid);
+    }
+}

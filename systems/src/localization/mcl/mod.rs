@@ -1,0 +1,307 @@
+//! Monte Carlo localization at the level of ROS AMCL (Fox, Burgard, Dellaert & Thrun 1999;
+//! Probabilistic Robotics Table 8.2 with the refinements of Tables 8.3 and 8.4):
+//!
+//! - particles as contiguous arrays (x, y, θ, weight);
+//! - prediction by the odometry motion model ([`super::motion_model`]), applied only once the
+//!   odometry has moved `update_min_d` or turned `update_min_a` since the last update;
+//! - correction by the likelihood field (default) or the beam model on `max_beams` beams
+//!   ([`sensor_model`]), weighed in parallel;
+//! - resampling only when N_eff = 1/Σw² < N/2 (Doucet et al. 2000; GMapping's adaptive
+//!   resampling) or when random particles are due; low-variance, KLD-adaptive count between a
+//!   minimum and a maximum ([`resample`]);
+//! - random-particle injection from short- and long-term averages of the measurement likelihood
+//!   (Augmented MCL), so a kidnapped robot is found again;
+//! - global initialisation uniformly over free space, or a Gaussian around a given pose;
+//! - estimate: weighted mean and covariance of the dominant cluster ([`cluster`]).
+
+pub mod cluster;
+pub mod resample;
+pub mod sensor_model;
+
+pub use cluster::PoseEstimate;
+pub use resample::{BinSize, CountLimits, kld_bound, normal_quantile};
+pub use sensor_model::{BeamSubset, LaserModelParams};
+
+use super::map::LocalizationMap;
+use super::motion_model::OdometryMotionModel;
+use crate::core::{Pose2, SimRng, wrap_angle};
+use rand::{Rng, RngExt, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
+use rayon::prelude::*;
+
+/// Which laser model weighs the particles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LaserModel {
+    LikelihoodField,
+    Beam,
+}
+
+/// How the particles start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InitialBelief {
+    /// Uniform over the free cells of the map, uniform heading.
+    Global,
+    /// Gaussian around a pose with standard deviations (m, m, rad).
+    Gaussian { pose: Pose2, sd: [f64; 3] },
+}
+
+/// Parameters, named after AMCL's where there is one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MclConfig {
+    pub min_particles: usize,
+    pub max_particles: usize,
+    /// KLD-sampling on (count between min and max) or off (always max).
+    pub kld: bool,
+    pub kld_err: f64,
+    /// Probability δ's complement (AMCL `kld_z` 0.99: the upper 1 % quantile).
+    pub kld_z: f64,
+    pub update_min_d: f64,
+    pub update_min_a: f64,
+    pub max_beams: usize,
+    pub model: LaserModel,
+    pub laser: LaserModelParams,
+    pub motion: OdometryMotionModel,
+    /// Augmented MCL averages (0 disables injection).
+    pub recovery_alpha_slow: f64,
+    pub recovery_alpha_fast: f64,
+    pub init: InitialBelief,
+    pub bins: BinSize,
+}
+
+impl Default for MclConfig {
+    fn default() -> Self {
+        MclConfig {
+            min_particles: 500,
+            max_particles: 5000,
+            kld: true,
+            kld_err: 0.01,
+            kld_z: 0.99,
+            update_min_d: 0.2,
+            update_min_a: std::f64::consts::PI / 6.0,
+            max_beams: 60,
+            model: LaserModel::LikelihoodField,
+            laser: LaserModelParams::default(),
+            motion: OdometryMotionModel::default(),
+            recovery_alpha_slow: 0.001,
+            recovery_alpha_fast: 0.1,
+            init: InitialBelief::Global,
+            bins: BinSize::default(),
+        }
+    }
+}
+
+/// Particles per motion-sampling work item (each seeded from the filter's stream in order).
+const MOTION_CHUNK: usize = 1024;
+
+/// The particle filter.
+#[derive(Clone, Debug)]
+pub struct Mcl {
+    pub config: MclConfig,
+    pub xs: Vec<f64>,
+    pub ys: Vec<f64>,
+    pub ths: Vec<f64>,
+    /// Normalised weights.
+    pub w: Vec<f64>,
+    rng: SimRng,
+    w_slow: f64,
+    w_fast: f64,
+    last_odom: Option<Pose2>,
+    table: Option<[f32; 256]>,
+    /// Updates done (a scan consumed after enough motion).
+    pub updates: u64,
+    /// Resamplings done.
+    pub resamplings: u64,
+    pub estimate: Option<PoseEstimate>,
+}
+
+impl Mcl {
+    pub fn new(config: MclConfig, map: &LocalizationMap, mut rng: SimRng) -> Self {
+        let n = config.max_particles.max(1);
+        let (mut xs, mut ys, mut ths) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for _ in 0..n {
+            let (x, y, th) = match config.init {
+                InitialBelief::Global => map.random_free_pose(&mut || rng.random::<f64>()),
+                InitialBelief::Gaussian { pose, sd } => {
+                    let mut g = || -> f64 { StandardNormal.sample(&mut rng) };
+                    (
+                        pose.x + sd[0] * g(),
+                        pose.y + sd[1] * g(),
+                        wrap_angle(pose.theta + sd[2] * g()),
+                    )
+                }
+            };
+            xs.push(x);
+            ys.push(y);
+            ths.push(th);
+        }
+        let mut mcl = Mcl {
+            config,
+            xs,
+            ys,
+            ths,
+            w: vec![1.0 / n as f64; n],
+            rng,
+            w_slow: 0.0,
+            w_fast: 0.0,
+            last_odom: None,
+            table: None,
+            updates: 0,
+            resamplings: 0,
+            estimate: None,
+        };
+        mcl.estimate = mcl.cluster();
+        mcl
+    }
+
+    pub fn len(&self) -> usize {
+        self.w.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.w.is_empty()
+    }
+
+    fn cluster(&self) -> Option<PoseEstimate> {
+        cluster::dominant_cluster(&self.xs, &self.ys, &self.ths, &self.w, &self.config.bins)
+    }
+
+    /// Moves every particle by the odometry motion `from` → `to`.
+    pub fn predict(&mut self, from: &Pose2, to: &Pose2) {
+        let d = self.config.motion.delta(from, to);
+        let model = self.config.motion;
+        let seeds: Vec<u64> = (0..self.len().div_ceil(MOTION_CHUNK))
+            .map(|_| self.rng.next_u64())
+            .collect();
+        self.xs
+            .par_chunks_mut(MOTION_CHUNK)
+            .zip(self.ys.par_chunks_mut(MOTION_CHUNK))
+            .zip(self.ths.par_chunks_mut(MOTION_CHUNK))
+            .zip(seeds)
+            .for_each(|(((x, y), t), seed)| {
+                let mut rng = SimRng::seed_from_u64(seed);
+                model.sample_slices(&d, x, y, t, &mut rng);
+            });
+    }
+
+    /// Multiplies the weights by the scan's likelihood; returns the mean likelihood factor.
+    pub fn weigh(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> f64 {
+        let old_total: f64 = self.w.iter().sum();
+        match self.config.model {
+            LaserModel::LikelihoodField => {
+                let table = *self.table.get_or_insert_with(|| {
+                    sensor_model::likelihood_table(
+                        &map.field,
+                        &self.config.laser,
+                        beams.range_max as f64,
+                    )
+                });
+                let points = beams.returns();
+                sensor_model::weigh_likelihood_field(
+                    &map.field,
+                    &table,
+                    &points,
+                    &self.xs,
+                    &self.ys,
+                    &self.ths,
+                    &mut self.w,
+                );
+            }
+            LaserModel::Beam => sensor_model::weigh_beam_model(
+                &map.rays,
+                &self.config.laser,
+                beams,
+                &self.xs,
+                &self.ys,
+                &self.ths,
+                &mut self.w,
+            ),
+        }
+        // w was normalised: Σ new w = Σ w_old·p = the weighted mean of p
+        let total: f64 = self.w.iter().sum();
+        if total > 0.0 && total.is_finite() {
+            self.w.iter_mut().for_each(|w| *w /= total);
+        } else {
+            let n = self.len() as f64;
+            self.w.iter_mut().for_each(|w| *w = 1.0 / n);
+        }
+        total / old_total.max(f64::MIN_POSITIVE)
+    }
+
+    /// Consumes a scan taken when the odometry read `odom`. Returns true if the filter updated
+    /// (the first scan, or enough motion since the last update).
+    pub fn update(&mut self, map: &LocalizationMap, beams: &BeamSubset, odom: &Pose2) -> bool {
+        if let Some(last) = self.last_odom {
+            let moved = last.distance(odom);
+            let turned = wrap_angle(odom.theta - last.theta).abs();
+            if moved < self.config.update_min_d && turned < self.config.update_min_a {
+                return false;
+            }
+            self.predict(&last, odom);
+        }
+        self.last_odom = Some(*odom);
+        if beams.is_empty() {
+            return true;
+        }
+        let mean_p = self.weigh(map, beams);
+        // Augmented MCL: the likelihood is normalised per beam count so α's mean the same for
+        // every laser
+        let avg = mean_p.max(f64::MIN_POSITIVE);
+        if self.w_slow == 0.0 {
+            self.w_slow = avg;
+            self.w_fast = avg;
+        } else {
+            self.w_slow += self.config.recovery_alpha_slow * (avg - self.w_slow);
+            self.w_fast += self.config.recovery_alpha_fast * (avg - self.w_fast);
+        }
+        let p_inject = if self.config.recovery_alpha_slow > 0.0 {
+            (1.0 - self.w_fast / self.w_slow).max(0.0)
+        } else {
+            0.0
+        };
+        let n_eff = 1.0 / self.w.iter().map(|w| w * w).sum::<f64>();
+        if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
+            // Unlike AMCL, the averages are not reset after an injection (Table 8.3 has no
+            // reset): AMCL's reset ends the injection after one burst of a few percent, which
+            // rarely finds a kidnapped robot; here random particles keep coming while the
+            // scans fit worse than they used to.
+            self.resample(map, p_inject);
+        }
+        self.updates += 1;
+        self.estimate = self.cluster();
+        true
+    }
+
+    fn resample(&mut self, map: &LocalizationMap, p_inject: f64) {
+        let limits = CountLimits {
+            min: self.config.min_particles,
+            max: self.config.max_particles,
+            kld: self.config.kld,
+            epsilon: self.config.kld_err,
+            z: normal_quantile(self.config.kld_z),
+        };
+        resample::resample(
+            &mut self.xs,
+            &mut self.ys,
+            &mut self.ths,
+            &mut self.w,
+            &limits,
+            &self.config.bins,
+            p_inject,
+            &mut self.rng,
+            |u| map.random_free_pose(u),
+        );
+        self.resamplings += 1;
+    }
+
+    /// The odometry pose of the last update.
+    pub fn last_odometry(&self) -> Option<Pose2> {
+        self.last_odom
+    }
+}
+
+#[cfg(test)]
+mod tests;
