@@ -1,5 +1,5 @@
 //! The simulator's ECS vocabulary and every system, layered bottom-up:
-//! `core` ← `world` ← `raycast`/`body` ← `sensors` ← `localization` ← `navigation`/`eval`.
+//! `core` ← `world` ← `raycast`/`body` ← `sensors` ← `matching` ← `localization` ← `navigation`/`eval`.
 //! Nothing lower imports anything higher (see ../shared/DESIGN.md).
 //!
 //! Each feature folder exposes one [`core::schedule::SimPlugin`] that adds its systems to the
@@ -9,6 +9,7 @@ pub mod body;
 pub mod core;
 pub mod eval;
 pub mod localization;
+pub mod matching;
 pub mod navigation;
 pub mod raycast;
 pub mod sensors;

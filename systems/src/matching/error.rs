@@ -1,0 +1,36 @@
+//! Errors of the scan matcher: every bad configuration or input is reported, never a panic.
+
+use super::de::Strategy;
+
+/// What is wrong with a matching request.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MatchError {
+    #[error("the reference scan has no finite points")]
+    EmptyReference,
+    #[error("the current scan has no finite points")]
+    EmptyCurrent,
+    #[error(
+        "population size {population} is too small for the {strategy} strategy: it needs at least {min}"
+    )]
+    PopulationTooSmall {
+        population: usize,
+        min: usize,
+        strategy: Strategy,
+    },
+    #[error("the mutation constant F must be finite and > 0, got {0}")]
+    InvalidF(f64),
+    #[error("the crossover rate CR must be in [0, 1], got {0}")]
+    InvalidCr(f64),
+    #[error(
+        "the evaluation budget {budget} cannot evaluate the initial population of {population}"
+    )]
+    BudgetTooSmall { budget: u64, population: usize },
+    #[error("search bounds of axis {axis} are invalid: [{lo}, {hi}] (need finite lo <= hi)")]
+    InvalidBounds { axis: usize, lo: f64, hi: f64 },
+    #[error("parameter `{name}` = {value} is invalid: expected {expected}")]
+    InvalidParameter {
+        name: &'static str,
+        value: f64,
+        expected: &'static str,
+    },
+}

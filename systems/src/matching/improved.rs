@@ -1,0 +1,506 @@
+//! The improved matcher: the thesis's idea — score a candidate transform by how well the moved
+//! current scan overlaps the reference (000_9f0113837c153763.txt §5.2, eq. 29) and search the
+//! transforms globally — rebuilt to be both right and fast, with DE kept as the global fallback.
+//! The thesis's failure modes shape it (§6.2, §7.3, §8): DE stagnates in local optima, the
+//! correlation mis-rotates scans, and symmetric rooms and corridors fool it. So rotations are
+//! proposed deliberately, translations are searched exhaustively, and candidates are judged
+//! with information the correlation ignores (free space).
+//!
+//! 1. **Subsampling** ([`super::subsample`]): both scans thinned to ~5 cm spacing (the near
+//!    range of a scan is 10× denser than needed), a coarser set of the current scan for the
+//!    searches.
+//! 2. **Reference model** ([`super::ref_grid`]): a smooth score grid (0.2 m) for the coarse
+//!    searches and a nearest-point index grid (0.1 m) for refinement, built once.
+//! 3. **Rotation hypotheses** ([`super::orientation`]): the orientation histograms of the surface
+//!    normals ([`super::normals`]) of both scans are cross-correlated (histogram correlation,
+//!    thesis §3.8); its best peaks are rotation candidates, independent of the translation.
+//! 4. **Translation search** ([`super::translation_search`]): for each rotation candidate, every
+//!    shift of the window on the score grid's lattice (±3 m in 0.2 m steps) is scored
+//!    exhaustively — the thesis's correlation for all shifts at once instead of DE samples — and
+//!    a few separated maxima are kept.
+//! 5. **Screening**: the best candidates by correlation are refined briefly (point-to-line
+//!    Gauss–Newton, [`super::refine`], on the coarse set) and judged by
+//!    `inliers − violation_weight · violations`: inliers are current points within
+//!    `inlier_distance` of the reference surface, violations are points of either scan that the
+//!    alignment puts in space the other scan saw as free ([`super::visibility`]).
+//! 6. **Final refinement**: the best screened candidates are refined on the fine set and judged
+//!    again; the best wins.
+//! 7. **DE fallback** ([`super::de`]): if the winner's judged score is below `fallback_below`
+//!    of the fine set (few normals, e.g. unordered points, or heavy clutter), a DE run on the
+//!    score grid, seeded with the candidates, searches the whole window; its best member is
+//!    refined and judged like the others.
+//!
+//! Everything is deterministic: no wall clock, no thread-count dependence, ties broken by order.
+
+use super::de::{self, Bounds, Crossover, DeParams, StallStop, Strategy, Vector};
+use super::error::MatchError;
+use super::normals::estimate_normals;
+use super::orientation::{orientation_histogram, rotation_hypotheses};
+use super::ref_grid::{MAX_INDEXED, NearestGrid, ScoreGrid};
+use super::refine::{Reference, RefineParams, refine};
+use super::subsample::subsample;
+use super::translation_search::{MAX_POINTS, Shift, best_shifts};
+use super::visibility::RangeImage;
+use crate::core::{SimRng, wrap_angle};
+
+/// Tunables of the improved matcher (defaults tuned on SICK LMS100 scans in the hospital map).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImprovedConfig {
+    /// Cell of the score grid and step of the translation search (m).
+    pub coarse_cell: f32,
+    /// Radius of the score kernel (m).
+    pub coarse_radius: f32,
+    /// Cell of the nearest-point grid of the refinement (m).
+    pub fine_cell: f32,
+    /// Rotation hypotheses taken from the orientation histogram correlation.
+    pub rotation_hypotheses: usize,
+    /// Separated translation maxima kept per rotation hypothesis.
+    pub shifts_per_rotation: usize,
+    /// Smallest spacing (m) and largest number (≤ 257) of current points in the searches.
+    pub coarse_spacing: f32,
+    pub coarse_points: usize,
+    /// Smallest spacing (m) and largest number (≤ 65 535) of points of each scan in the
+    /// refinement and the final judgement.
+    pub fine_spacing: f32,
+    pub fine_points: usize,
+    /// Candidates (best correlation first) refined briefly and judged.
+    pub screened: usize,
+    /// Screened candidates (best judged first) refined fully.
+    pub finalists: usize,
+    /// Gauss–Newton iterations of the brief and the full refinement.
+    pub screen_iterations: usize,
+    pub final_iterations: usize,
+    /// Correspondence gate at the start of refinement (m); it shrinks to `2 · inlier_distance`.
+    pub gate: f32,
+    /// A current point is an inlier if it is within this of the reference surface (m).
+    pub inlier_distance: f32,
+    /// A point more than this in front of the other scan's reading is a free-space violation (m).
+    pub violation_margin: f32,
+    /// Weight of a violation against an inlier in the judgement.
+    pub violation_weight: f32,
+    /// A refined translation whose least-constrained direction carries less than this share of
+    /// the information of the best-constrained one is searched along that direction.
+    pub weak_ratio: f64,
+    /// Half-length (m) and step (m) of that line search.
+    pub weak_search: f32,
+    pub weak_step: f32,
+    /// Run the DE fallback when the winner's judged score, as a fraction of the fine set, is
+    /// below this (0 disables the fallback).
+    pub fallback_below: f32,
+    /// The DE fallback (evaluation-budgeted; serial by default: the matcher is single-core).
+    pub fallback: DeParams,
+}
+
+impl Default for ImprovedConfig {
+    fn default() -> Self {
+        ImprovedConfig {
+            coarse_cell: 0.2,
+            coarse_radius: 0.5,
+            fine_cell: 0.1,
+            rotation_hypotheses: 8,
+            shifts_per_rotation: 6,
+            coarse_spacing: 0.3,
+            coarse_points: 128,
+            fine_spacing: 0.05,
+            fine_points: 400,
+            screened: 24,
+            finalists: 2,
+            screen_iterations: 6,
+            final_iterations: 15,
+            gate: 0.5,
+            inlier_distance: 0.05,
+            violation_margin: 0.2,
+            violation_weight: 8.0,
+            weak_ratio: 0.3,
+            weak_search: 0.6,
+            weak_step: 0.05,
+            fallback_below: 0.2,
+            fallback: DeParams {
+                population: 24,
+                generations: 100,
+                f: 0.5,
+                cr: 0.9,
+                strategy: Strategy::RandToBest1,
+                crossover: Crossover::Binomial,
+                either_or_probability: None,
+                max_evaluations: Some(2_400),
+                time_limit: None,
+                stall: Some(StallStop {
+                    generations: 20,
+                    tolerance: 0.0,
+                }),
+                collapse_tolerance: Some(1e-3),
+                parallel: false,
+            },
+        }
+    }
+}
+
+impl ImprovedConfig {
+    /// Checks every tunable; errors name the field.
+    pub fn validate(&self) -> Result<(), MatchError> {
+        let pos = |name, v: f32| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(MatchError::InvalidParameter {
+                    name,
+                    value: v as f64,
+                    expected: "a finite value > 0",
+                })
+            }
+        };
+        pos("improved.coarse_cell", self.coarse_cell)?;
+        pos("improved.coarse_radius", self.coarse_radius)?;
+        pos("improved.fine_cell", self.fine_cell)?;
+        pos("improved.coarse_spacing", self.coarse_spacing)?;
+        pos("improved.fine_spacing", self.fine_spacing)?;
+        pos("improved.gate", self.gate)?;
+        pos("improved.inlier_distance", self.inlier_distance)?;
+        pos("improved.violation_margin", self.violation_margin)?;
+        pos("improved.weak_search", self.weak_search)?;
+        pos("improved.weak_step", self.weak_step)?;
+        if !(0.0..=1.0).contains(&self.weak_ratio) {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.weak_ratio",
+                value: self.weak_ratio,
+                expected: "a ratio in [0, 1]",
+            });
+        }
+        if self.weak_search / self.weak_step > 1000.0 {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.weak_step",
+                value: self.weak_step as f64,
+                expected: "at most 1000 steps per side of the line search",
+            });
+        }
+        if !(self.violation_weight.is_finite() && self.violation_weight >= 0.0) {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.violation_weight",
+                value: self.violation_weight as f64,
+                expected: "a finite weight >= 0",
+            });
+        }
+        let count = |name, v: usize, max: usize, expected| {
+            if (1..=max).contains(&v) {
+                Ok(())
+            } else {
+                Err(MatchError::InvalidParameter {
+                    name,
+                    value: v as f64,
+                    expected,
+                })
+            }
+        };
+        count(
+            "improved.rotation_hypotheses",
+            self.rotation_hypotheses,
+            360,
+            "1 ..= 360",
+        )?;
+        count(
+            "improved.shifts_per_rotation",
+            self.shifts_per_rotation,
+            64,
+            "1 ..= 64",
+        )?;
+        count(
+            "improved.coarse_points",
+            self.coarse_points,
+            MAX_POINTS,
+            "1 ..= 257",
+        )?;
+        count(
+            "improved.fine_points",
+            self.fine_points,
+            MAX_INDEXED,
+            "1 ..= 65535",
+        )?;
+        count("improved.screened", self.screened, 10_000, "1 ..= 10000")?;
+        count("improved.finalists", self.finalists, 10_000, "1 ..= 10000")?;
+        count(
+            "improved.screen_iterations",
+            self.screen_iterations,
+            1000,
+            "1 ..= 1000",
+        )?;
+        count(
+            "improved.final_iterations",
+            self.final_iterations,
+            1000,
+            "1 ..= 1000",
+        )?;
+        if !(0.0..=1.0).contains(&self.fallback_below) {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.fallback_below",
+                value: self.fallback_below as f64,
+                expected: "a fraction in [0, 1]",
+            });
+        }
+        if self.fallback_below > 0.0 {
+            self.fallback.validate()?;
+        }
+        Ok(())
+    }
+}
+
+/// The outcome of [`match_improved`].
+pub(crate) struct ImprovedOutcome {
+    pub transform: Vector,
+    /// Inlier fraction of the fine current set at the answer.
+    pub inliers: f64,
+    /// Candidate transforms scored: shifts, refinement iterations, judgements, DE evaluations.
+    pub evaluations: u64,
+}
+
+/// What the judge sees of both scans.
+struct Judge<'a> {
+    model: Reference<'a>,
+    ref_image: RangeImage,
+    cur_image: RangeImage,
+    inlier_distance: f32,
+    end_tangent: f32,
+    margin: f32,
+    weight: f32,
+}
+
+impl Judge<'_> {
+    /// (inliers of `current`, free-space violations of both sets) for transform `t`.
+    fn count(&self, current: &[[f32; 2]], reference: &[[f32; 2]], t: &Vector) -> (usize, usize) {
+        let (s, c) = t[2].sin_cos();
+        let (s, c, tx, ty) = (s as f32, c as f32, t[0] as f32, t[1] as f32);
+        let mut inliers = 0;
+        let mut violations = 0;
+        for b in current {
+            let q = [c * b[0] - s * b[1] + tx, s * b[0] + c * b[1] + ty];
+            if self
+                .model
+                .distance(q, self.end_tangent)
+                .is_some_and(|d| d <= self.inlier_distance)
+            {
+                inliers += 1;
+            } else if self.ref_image.violates(q, self.margin) {
+                violations += 1;
+            }
+        }
+        // reference points in the current frame: b = Rᵀ (a − t)
+        for a in reference {
+            let (dx, dy) = (a[0] - tx, a[1] - ty);
+            if self
+                .cur_image
+                .violates([c * dx + s * dy, -s * dx + c * dy], self.margin)
+            {
+                violations += 1;
+            }
+        }
+        (inliers, violations)
+    }
+
+    /// Inliers of `current` only.
+    fn inliers(&self, current: &[[f32; 2]], t: &Vector) -> usize {
+        let (s, c) = t[2].sin_cos();
+        let (s, c, tx, ty) = (s as f32, c as f32, t[0] as f32, t[1] as f32);
+        current
+            .iter()
+            .filter(|b| {
+                let q = [c * b[0] - s * b[1] + tx, s * b[0] + c * b[1] + ty];
+                self.model
+                    .distance(q, self.end_tangent)
+                    .is_some_and(|d| d <= self.inlier_distance)
+            })
+            .count()
+    }
+
+    /// The judged score `inliers − weight · violations`.
+    fn score(&self, current: &[[f32; 2]], reference: &[[f32; 2]], t: &Vector) -> (f64, usize) {
+        let (inl, viol) = self.count(current, reference, t);
+        (inl as f64 - self.weight as f64 * viol as f64, inl)
+    }
+}
+
+/// Runs the pipeline of the module docs. Points must be finite and both sets non-empty.
+pub(crate) fn match_improved(
+    reference: &[[f32; 2]],
+    current: &[[f32; 2]],
+    bounds: &Bounds,
+    cfg: &ImprovedConfig,
+    rng: &mut SimRng,
+) -> Result<ImprovedOutcome, MatchError> {
+    cfg.validate()?;
+    bounds.validate()?;
+    let normal_gate = 0.5;
+    // 1. subsampling
+    let ref_fine = subsample(
+        reference,
+        cfg.fine_spacing,
+        cfg.fine_points.max(2 * cfg.coarse_points).min(MAX_INDEXED),
+    );
+    let cur_fine = subsample(current, cfg.fine_spacing, cfg.fine_points);
+    let cur_coarse = subsample(current, cfg.coarse_spacing, cfg.coarse_points);
+    let ref_coarse = subsample(reference, cfg.coarse_spacing, cfg.coarse_points);
+    let ref_normals = estimate_normals(&ref_fine, normal_gate);
+    let cur_normals = estimate_normals(&cur_fine, normal_gate);
+    // 2. reference model
+    let score_grid = ScoreGrid::build(&ref_fine, cfg.coarse_cell, cfg.coarse_radius, 2);
+    let nearest = NearestGrid::build(&ref_fine, cfg.fine_cell, cfg.gate, 3);
+    let judge = Judge {
+        model: Reference {
+            points: &ref_fine,
+            normals: &ref_normals,
+            grid: &nearest,
+        },
+        ref_image: RangeImage::build(reference),
+        cur_image: RangeImage::build(current),
+        inlier_distance: cfg.inlier_distance,
+        end_tangent: 1.2 * cfg.inlier_distance,
+        margin: cfg.violation_margin,
+        weight: cfg.violation_weight,
+    };
+    // 3. rotation hypotheses
+    let max_theta = if bounds.theta_periodic() {
+        std::f64::consts::PI
+    } else {
+        bounds.hi[2].abs().min(bounds.lo[2].abs())
+    };
+    let hyps = rotation_hypotheses(
+        &orientation_histogram(&ref_fine, &ref_normals),
+        &orientation_histogram(&cur_fine, &cur_normals),
+        cfg.rotation_hypotheses,
+        max_theta,
+    );
+    // 4. translation search per rotation
+    let cell = cfg.coarse_cell as f64;
+    let reach_x = (bounds.hi[0].min(-bounds.lo[0]) / cell).floor().max(0.0) as i32;
+    let reach_y = (bounds.hi[1].min(-bounds.lo[1]) / cell).floor().max(0.0) as i32;
+    let radius = reach_x.max(reach_y);
+    let separation = ((0.5 / cell).round() as i32).max(1);
+    let mut evaluations = 0u64;
+    let (mut acc, mut shifts) = (Vec::new(), Vec::<Shift>::new());
+    let mut cells = Vec::with_capacity(cur_coarse.len());
+    let mut candidates: Vec<(Vector, u32)> = Vec::new();
+    for &(theta, _) in &hyps {
+        let (s, c) = theta.sin_cos();
+        let (s, c) = (s as f32, c as f32);
+        cells.clear();
+        cells.extend(cur_coarse.iter().map(|b| {
+            score_grid
+                .geom
+                .cell_coords([c * b[0] - s * b[1], s * b[0] + c * b[1]])
+        }));
+        shifts.clear();
+        best_shifts(
+            &score_grid,
+            &cells,
+            radius,
+            cfg.shifts_per_rotation,
+            separation,
+            &mut acc,
+            &mut shifts,
+        );
+        evaluations += ((2 * radius + 1) * (2 * radius + 1)) as u64;
+        for sh in &shifts {
+            let t = [sh.i as f64 * cell, sh.k as f64 * cell, theta];
+            if bounds.contains(&t) {
+                candidates.push((t, sh.score));
+            }
+        }
+    }
+    // best correlation first; the sort is stable, so ties keep the hypothesis order
+    candidates.sort_by_key(|c| std::cmp::Reverse(c.1));
+
+    // 5. screening
+    let quick = RefineParams {
+        iterations: cfg.screen_iterations,
+        gate_start: cfg.gate,
+        gate_end: (3.0 * cfg.inlier_distance).min(cfg.gate),
+        huber: cfg.inlier_distance,
+        end_tangent: judge.end_tangent,
+    };
+    let full = RefineParams {
+        iterations: cfg.final_iterations,
+        gate_end: (2.0 * cfg.inlier_distance).min(cfg.gate),
+        ..quick
+    };
+    let keep_inside = |r: Vector, start: Vector| if bounds.contains(&r) { r } else { start };
+    let mut screened: Vec<(Vector, f64)> = Vec::new();
+    for &(t, _) in candidates.iter().take(cfg.screened) {
+        let r = keep_inside(refine(&judge.model, &cur_coarse, t, &quick).x, t);
+        let (score, _) = judge.score(&cur_coarse, &ref_coarse, &r);
+        evaluations += cfg.screen_iterations as u64 + 1;
+        screened.push((r, score));
+    }
+    screened.sort_by(|a, b| b.1.total_cmp(&a.1));
+
+    // 6. final refinement
+    let finalize = |start: Vector| -> (Vector, f64, usize) {
+        let refined = refine(&judge.model, &cur_fine, start, &full);
+        let mut r = keep_inside(refined.x, start);
+        // weakly constrained translation (a corridor): point-to-line barely feels the few wall
+        // ends that fix the position along it, so search that line with the judge and refine
+        // again from the best point
+        if refined.weak_ratio < cfg.weak_ratio {
+            let d = refined.weak_direction;
+            let steps = (cfg.weak_search / cfg.weak_step).round() as i32;
+            let mut best = (judge.inliers(&cur_fine, &r), 0i32);
+            for k in (-steps..=steps).filter(|&k| k != 0) {
+                let o = k as f64 * cfg.weak_step as f64;
+                let t = [r[0] + o * d[0], r[1] + o * d[1], r[2]];
+                if !bounds.contains(&t) {
+                    continue;
+                }
+                let n = judge.inliers(&cur_fine, &t);
+                // more inliers wins; on ties the smaller offset
+                if n > best.0 || (n == best.0 && k.abs() < best.1.abs()) {
+                    best = (n, k);
+                }
+            }
+            if best.1 != 0 {
+                let o = best.1 as f64 * cfg.weak_step as f64;
+                let t = [r[0] + o * d[0], r[1] + o * d[1], r[2]];
+                let again = keep_inside(refine(&judge.model, &cur_fine, t, &full).x, t);
+                if judge.score(&cur_fine, &ref_fine, &again).0
+                    > judge.score(&cur_fine, &ref_fine, &r).0
+                {
+                    r = again;
+                }
+            }
+        }
+        let (score, inl) = judge.score(&cur_fine, &ref_fine, &r);
+        (r, score, inl)
+    };
+    let mut best: Option<(Vector, f64, usize)> = None;
+    for &(t, _) in screened.iter().take(cfg.finalists) {
+        let c = finalize(t);
+        evaluations += cfg.final_iterations as u64 + 1;
+        if best.is_none_or(|b| c.1 > b.1) {
+            best = Some(c);
+        }
+    }
+
+    // 7. DE fallback
+    let n_fine = cur_fine.len().max(1) as f64;
+    let weak = best.is_none_or(|b| b.1 / n_fine < cfg.fallback_below as f64);
+    if weak && cfg.fallback_below > 0.0 {
+        let seeds: Vec<Vector> = screened
+            .iter()
+            .map(|s| s.0)
+            .chain(candidates.iter().map(|c| c.0))
+            .collect();
+        let cost = |p: &Vector| -(score_grid.correlate(&cur_coarse, p) as f64);
+        let out = de::minimize(&cost, bounds, &cfg.fallback, &seeds, rng)?;
+        evaluations += out.evaluations;
+        let start = out.best;
+        let quick_r = keep_inside(refine(&judge.model, &cur_coarse, start, &quick).x, start);
+        let c = finalize(quick_r);
+        evaluations += (cfg.screen_iterations + cfg.final_iterations) as u64 + 1;
+        if best.is_none_or(|b| c.1 > b.1) {
+            best = Some(c);
+        }
+    }
+    let (transform, _, inliers) = best.unwrap_or(([0.0; 3], 0.0, 0));
+    Ok(ImprovedOutcome {
+        transform: [transform[0], transform[1], wrap_angle(transform[2])],
+        inliers: inliers as f64 / n_fine,
+        evaluations,
+    })
+}

@@ -1,0 +1,49 @@
+//! Scan-matching kernels shared by localization and mapping (see ../shared/DESIGN.md): the
+//! differential-evolution scan matcher of 000_9f0113837c153763.txt and its fitness functions,
+//! plus an improved matcher built from the same ideas.
+//!
+//! Entry point: [`match_scans`]`(reference, current, &MatchConfig) -> MatchResult`, which finds
+//! the transform `(x, y, θ)` moving the current scan's points into the reference scan's frame.
+//! Points come from [`scan_to_points`] (eq. 28). [`MatchConfig::default`] is the improved matcher
+//! over ±3 m, ±180°; [`MatchConfig::thesis_program`], [`MatchConfig::thesis_figure_run`] and
+//! [`MatchConfig::thesis_final_experiment`] reproduce the thesis's settings.
+//!
+//! Modules (one algorithm each):
+//! * [`scan_points`] — scan → Cartesian points (eq. 28);
+//! * [`de`] — the DE optimizer: nine strategies (eqs. 19–27), two crossovers, selection, stops;
+//! * [`correlation`] — the thesis's raster cross-correlation fitness (eqs. 29, 31, 32);
+//! * [`euclidean`] — the thesis's Euclidean reference fitness (§7.1) and its distance-field form;
+//! * `normals`, `orientation`, `ref_grid`, `translation_search`, `refine`, `subsample`,
+//!   `improved` — the improved matcher's stages (private);
+//! * `matcher` — configuration and the entry point.
+
+pub mod correlation;
+pub mod de;
+pub mod euclidean;
+pub mod scan_points;
+
+mod error;
+mod fast_atan2;
+mod improved;
+mod matcher;
+mod normals;
+mod orientation;
+mod ref_grid;
+mod refine;
+mod subsample;
+mod translation_search;
+mod visibility;
+
+#[cfg(test)]
+mod tests;
+
+pub use correlation::{CorrelationFitness, RasterSpec};
+pub use de::{Bounds, Crossover, DeOutcome, DeParams, StallStop, StopReason, Strategy, Vector};
+pub use error::MatchError;
+pub use euclidean::{EuclideanField, euclidean_brute};
+pub use improved::ImprovedConfig;
+pub use matcher::{
+    MatchConfig, MatchResult, Method, SearchWindow, ThesisConfig, ThesisFitness, match_scans,
+    match_scans_with_rng,
+};
+pub use scan_points::{laser_scan_points, scan_to_points, scan_to_points_into};
