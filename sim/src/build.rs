@@ -11,8 +11,11 @@ use systems::core::{
     KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimSet, new_schedule, stream_rng,
 };
 use systems::eval::{EvalPlugin, LocalizationSamples, RobotMetrics};
+use systems::localization::de_filter::DeFilter;
+use systems::localization::de_mc::DeMc;
+use systems::localization::de_odometry::DeOdometry;
 use systems::localization::{
-    Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, Mcl, NavBelief,
+    Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
     OdometryModel, WheelOdometry,
 };
 use systems::navigation::{Behaviour, NavigationPlugin};
@@ -50,12 +53,15 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
     let mut physics = Physics::new(&mut static_world, scenario.dt);
     world.insert_resource(static_world);
     // the map localizers believe in: the floor plan as it is at the start
+    let any_localizer = scenario.robots.iter().any(|r| !r.localizers.is_empty());
     let field_max_dist = scenario
         .robots
         .iter()
         .flat_map(|r| r.localizers.iter().filter_map(|l| l.field_max_dist()))
         .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))));
-    if let Some(max_dist) = field_max_dist {
+    if any_localizer {
+        // DE localizers ray-cast only; the field is then small and unused
+        let max_dist = field_max_dist.unwrap_or(scenario.grid.resolution);
         world.insert_resource(LocalizationMap::new(scenario.grid.clone(), max_dist));
     }
 
@@ -166,6 +172,18 @@ fn spawn_robot(
                     let filter = match &l.kind {
                         LocalizerKind::Mcl(c) => {
                             Filter::Mcl(Box::new(Mcl::new(c.clone(), map, rng)))
+                        }
+                        LocalizerKind::MarkovGrid(c) => {
+                            Filter::MarkovGrid(Box::new(MarkovGrid::new(c.clone(), map)))
+                        }
+                        LocalizerKind::DeFilter(c) => {
+                            Filter::DeFilter(Box::new(DeFilter::new(c.clone(), map, rng)))
+                        }
+                        LocalizerKind::DeMc(c) => {
+                            Filter::DeMc(Box::new(DeMc::new(c.clone(), map, rng)))
+                        }
+                        LocalizerKind::DeOdometry(c) => {
+                            Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
                         }
                     };
                     Localizer::new(l.name.clone(), filter)

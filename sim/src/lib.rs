@@ -2,9 +2,13 @@
 //! and the `sim` command line.
 
 pub mod bench;
+pub mod bench_match;
 pub mod build;
+pub mod experiment;
+pub mod match_cmd;
 pub mod record;
 pub mod runner;
+pub mod scans;
 pub mod scenario;
 pub mod script;
 pub mod summary;

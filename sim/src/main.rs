@@ -2,6 +2,10 @@
 
 use clap::{Parser, Subcommand};
 use sim::bench::{SwarmOptions, run_swarm_bench};
+use sim::bench_match::{DeMatchBenchOptions, run_de_match_bench};
+use sim::experiment::de_match::{DeMatchOptions, run_de_match_experiment};
+use sim::match_cmd::{CrossoverArg, FitnessArg, MatchOptions, parse_strategy, run_match};
+use sim::runner::ScanCapture;
 use sim::scenario::{DEFAULT_SCENARIO, bundled_scenarios, find_scenario, load_scenario};
 use sim::{RunOptions, run_scenario};
 use std::path::PathBuf;
@@ -50,6 +54,90 @@ enum Command {
     },
     /// List the bundled scenarios.
     Scenarios,
+    /// Capture laser scans with their true sensor poses into a SCANS file (CSV, see README).
+    /// Localizers are not run: they never influence motion or sensing.
+    Scans {
+        /// A scenario file or the name of a bundled scenario (default: hospital_patrol).
+        scenario: Option<String>,
+        /// The SCANS file to write.
+        #[arg(long)]
+        out: PathBuf,
+        /// Keep one scan per robot every this many simulated seconds.
+        #[arg(long, default_value_t = 0.1, allow_negative_numbers = true)]
+        period: f64,
+        /// Override the scenario's duration (simulated seconds).
+        #[arg(long, allow_negative_numbers = true)]
+        duration: Option<f64>,
+        /// Only this robot's scans (repeatable; default: every robot with a laser).
+        #[arg(long = "robot")]
+        robots: Vec<String>,
+        /// Override the scenario's seed.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Worker threads for parallel kernels (0 = one per core). Results do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// No progress bar and no report, only errors.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Align two scans of a SCANS file (the thesis's program: -file, -reference, -current,
+    /// -gen, -pop, -F, -C) and compare with the true transform.
+    Match {
+        /// The SCANS file.
+        scans: PathBuf,
+        /// Index of the reference scan (the `index` column).
+        #[arg(long)]
+        reference: u64,
+        /// Index of the current (test) scan.
+        #[arg(long)]
+        current: u64,
+        /// Matcher: the thesis's DE with a fitness, or the improved matcher.
+        #[arg(long, value_enum, default_value_t = FitnessArg::Improved)]
+        fitness: FitnessArg,
+        /// DE mutation strategy (default rand1): rand1, rand2, best1, best2, current-to-best1,
+        /// current-to-best2, rand-to-best1, rand-to-best2, either-or.
+        #[arg(long, value_parser = parse_strategy)]
+        strategy: Option<systems::matching::Strategy>,
+        /// DE crossover (default binomial).
+        #[arg(long, value_enum)]
+        crossover: Option<CrossoverArg>,
+        /// DE population size (default 100, the thesis program's).
+        #[arg(long, allow_negative_numbers = true)]
+        pop: Option<usize>,
+        /// DE generations (default 10000, the thesis program's).
+        #[arg(long)]
+        gens: Option<usize>,
+        /// DE mutation constant F (default 0.9).
+        #[arg(short = 'F', allow_negative_numbers = true)]
+        f: Option<f64>,
+        /// DE crossover rate CR (default 0.9).
+        #[arg(short = 'C', allow_negative_numbers = true)]
+        cr: Option<f64>,
+        /// Stop the DE after this many generations without improvement (default: never).
+        #[arg(long)]
+        stall: Option<usize>,
+        /// Wall-time limit of the DE in seconds (the thesis's -time; breaks determinism).
+        #[arg(long, allow_negative_numbers = true)]
+        time: Option<f64>,
+        /// Search window: |x|, |y| <= this (m).
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+        max_xy: f64,
+        /// Search window: |θ| <= this (degrees).
+        #[arg(long, default_value_t = 180.0, allow_negative_numbers = true)]
+        max_theta: f64,
+        /// Seed of the matcher's random stream.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// One JSON object instead of the text report.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Experiments reproducing the seed documents.
+    Experiment {
+        #[command(subcommand)]
+        which: ExperimentCommand,
+    },
     /// Benchmarks.
     Bench {
         #[command(subcommand)]
@@ -77,6 +165,66 @@ enum BenchCommand {
         #[arg(long, default_value_t = 0)]
         threads: usize,
     },
+    /// DE scan-matching time per alignment of 1081-beam hospital scans (one core).
+    DeMatch {
+        /// One JSON object per method, one per line.
+        #[arg(long)]
+        json: bool,
+        /// Number of hospital scan pairs timed.
+        #[arg(long, default_value_t = 100)]
+        pairs: usize,
+    },
+}
+
+#[derive(Subcommand)]
+enum ExperimentCommand {
+    /// The scan-matching protocol of 000_9f0113837c153763.txt on maze and hospital scans:
+    /// success λ, σx, σy, σθ and time per alignment for every DE strategy, the Euclidean
+    /// reference and the improved matcher.
+    DeMatch {
+        /// One JSON object per row, one per line.
+        #[arg(long)]
+        json: bool,
+        /// The thesis's full protocol: 80 reference scans × steps 5, 10, 20, 30 × 50 repeats,
+        /// up to 5000 generations (hours).
+        #[arg(long)]
+        full: bool,
+        /// Worker threads for the pairs (0 = one per core). Results do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Seed of the pair selection and of the matchers.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Pairs of the default protocol (a small number for quick checks).
+        #[arg(long, hide = true, conflicts_with = "full")]
+        pairs: Option<usize>,
+        /// Pairs on which the brute-force Euclidean reference runs.
+        #[arg(long, default_value_t = 50)]
+        brute_pairs: usize,
+        /// Write the captured scans of both scenarios to this folder (maze_run.csv,
+        /// hospital_patrol.csv), for `sim match`.
+        #[arg(long)]
+        save_scans: Option<PathBuf>,
+        /// Only the methods whose name contains this text (e.g. `improved`, `rand/1`).
+        #[arg(long)]
+        only: Option<String>,
+        /// Print every wrong alignment (scan indices, truth, answer) to stderr.
+        #[arg(long)]
+        list_wrong: bool,
+    },
+}
+
+/// A scenario file or the name of a bundled scenario (default: hospital_patrol).
+fn resolve_scenario(arg: Option<String>) -> anyhow::Result<sim::Scenario> {
+    let arg = arg.unwrap_or_else(|| DEFAULT_SCENARIO.to_string());
+    let path = find_scenario(&arg).ok_or_else(|| {
+        let names: Vec<String> = bundled_scenarios().into_iter().map(|(n, _)| n).collect();
+        anyhow::anyhow!(
+            "{arg}: no such file and no bundled scenario of that name (bundled: {})",
+            names.join(", ")
+        )
+    })?;
+    Ok(load_scenario(&path)?)
 }
 
 fn main() -> ExitCode {
@@ -184,6 +332,114 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        Command::Scans {
+            scenario,
+            out,
+            period,
+            duration,
+            robots,
+            seed,
+            threads,
+            quiet,
+        } => {
+            let mut sc = resolve_scenario(scenario)?;
+            if let Some(s) = seed {
+                sc.seed = s;
+            }
+            if let Some(d) = duration {
+                if !(d.is_finite() && d > 0.0) {
+                    anyhow::bail!("--duration: expected a positive number of seconds, got {d}");
+                }
+                sc.duration = d;
+            }
+            if !(period.is_finite() && period > 0.0) {
+                anyhow::bail!("--period: expected a positive number of seconds, got {period}");
+            }
+            let capture = ScanCapture {
+                period_s: period,
+                robots: (!robots.is_empty()).then_some(robots),
+            };
+            if !quiet {
+                eprintln!(
+                    "capturing scans of {} ({} robots, {:.1} s simulated, seed {}, one scan per \
+                     robot every {period} s)",
+                    sc.name,
+                    sc.robots.len(),
+                    sc.duration,
+                    sc.seed
+                );
+            }
+            let scans = sim::scans::capture_scans(&sc, &capture, threads, !quiet)?;
+            if scans.is_empty() {
+                anyhow::bail!(
+                    "{}: no laser scans captured (does any selected robot carry a laser?)",
+                    sc.source
+                );
+            }
+            sim::scans::write_scans(&out, &scans)?;
+            if !quiet {
+                println!("{} scans written to {}", scans.len(), out.display());
+            }
+            Ok(())
+        }
+        Command::Match {
+            scans,
+            reference,
+            current,
+            fitness,
+            strategy,
+            crossover,
+            pop,
+            gens,
+            f,
+            cr,
+            stall,
+            time,
+            max_xy,
+            max_theta,
+            seed,
+            json,
+        } => run_match(&MatchOptions {
+            scans,
+            reference,
+            current,
+            fitness,
+            strategy,
+            crossover,
+            population: pop,
+            generations: gens,
+            f,
+            cr,
+            stall,
+            time_limit: time,
+            max_xy,
+            max_theta_deg: max_theta,
+            seed,
+            json,
+        }),
+        Command::Experiment { which } => match which {
+            ExperimentCommand::DeMatch {
+                json,
+                full,
+                threads,
+                seed,
+                pairs,
+                brute_pairs,
+                save_scans,
+                only,
+                list_wrong,
+            } => run_de_match_experiment(&DeMatchOptions {
+                json,
+                full,
+                threads,
+                seed,
+                pairs,
+                brute_pairs,
+                save_scans,
+                only,
+                list_wrong,
+            }),
+        },
         Command::Bench { which } => match which {
             BenchCommand::Swarm {
                 json,
@@ -198,6 +454,9 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
                 duration,
                 threads,
             }),
+            BenchCommand::DeMatch { json, pairs } => {
+                run_de_match_bench(&DeMatchBenchOptions { json, pairs })
+            }
         },
     }
 }

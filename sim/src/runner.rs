@@ -3,6 +3,7 @@
 
 use crate::build::{SimWorld, build_world};
 use crate::record::{RrdRecorder, record_rrd};
+use crate::scans::ScanRecord;
 use crate::scenario::Scenario;
 use crate::summary::{RobotSummary, Summary};
 use bevy_ecs::prelude::*;
@@ -14,6 +15,7 @@ use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
 use systems::eval::{LocalizationSamples, LocalizerMetrics, RobotMetrics, Sample};
 use systems::localization::Localizers;
 use systems::navigation::{Behaviour, NavStatus};
+use systems::sensors::{LaserScans, LaserTruth};
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
@@ -27,12 +29,27 @@ pub struct RunOptions {
     pub trajectory_period: Option<f64>,
 }
 
+/// Laser scans to collect during a run, with the true sensor pose of each (SCANS files, scan
+/// matching experiments). Passed to [`run_scenario_capturing`]; a separate argument rather than
+/// a [`RunOptions`] field so existing `RunOptions { .. }` literals keep compiling.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScanCapture {
+    /// Keep one scan per robot every `period_s` seconds of simulated time: the first scan whose
+    /// stamp reaches each multiple of the period (every scan if the laser is slower).
+    pub period_s: f64,
+    /// Only these robots (by name); `None` = every robot with a laser.
+    pub robots: Option<Vec<String>>,
+}
+
 pub struct RunOutput {
     pub summary: Summary,
     /// (time, true pose of each robot in index order), if requested.
     pub trajectory: Vec<(f64, Vec<Pose2>)>,
     /// Every robot's localizer estimates paired with the truth, in robot index order.
     pub localization: Vec<RobotLocalization>,
+    /// Captured scans ([`run_scenario_capturing`]; empty otherwise), in time order, robots in
+    /// index order within a tick; `index` counts from 0.
+    pub scans: Vec<ScanRecord>,
 }
 
 /// The estimate/truth samples of one robot's localizers.
@@ -52,6 +69,100 @@ fn truth_poses(w: &mut World) -> Vec<Pose2> {
 
 /// Runs a scenario to its end.
 pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<RunOutput> {
+    run(scenario, opts, None)
+}
+
+/// Runs a scenario to its end and collects laser scans as `capture` asks.
+pub fn run_scenario_capturing(
+    scenario: &Scenario,
+    opts: &RunOptions,
+    capture: &ScanCapture,
+) -> anyhow::Result<RunOutput> {
+    if !(capture.period_s.is_finite() && capture.period_s > 0.0) {
+        anyhow::bail!(
+            "scan capture period: expected a positive number of seconds, got {}",
+            capture.period_s
+        );
+    }
+    if let Some(names) = &capture.robots {
+        for n in names {
+            match scenario.robots.iter().find(|r| &r.name == n) {
+                None => {
+                    let all: Vec<&str> = scenario.robots.iter().map(|r| r.name.as_str()).collect();
+                    anyhow::bail!(
+                        "{}: no robot named `{n}` (robots: {})",
+                        scenario.source,
+                        all.join(", ")
+                    );
+                }
+                Some(r) if r.laser.is_none() => {
+                    anyhow::bail!("{}: robot `{n}` has no laser", scenario.source)
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    run(scenario, opts, Some(capture))
+}
+
+/// Per-robot state of a scan capture.
+struct Capturer<'a> {
+    capture: &'a ScanCapture,
+    /// (robot index → next multiple of the period to take)
+    next: Vec<u64>,
+    scans: Vec<ScanRecord>,
+}
+
+impl Capturer<'_> {
+    /// Takes the scans of this tick (robots in index order).
+    fn collect(&mut self, w: &mut World) {
+        let mut q = w.query::<(&RobotIndex, &RobotId, &LaserScans, &LaserTruth)>();
+        let mut rows: Vec<_> = q.iter(w).collect();
+        rows.sort_by_key(|(i, ..)| **i);
+        let period = self.capture.period_s;
+        // a scan at k·period may carry rounding (0.30000000000000004): accept it a hair early
+        let eps = 1e-6 * period.max(1e-3);
+        for (i, id, scans, truth) in rows {
+            if let Some(names) = &self.capture.robots
+                && !names.contains(&id.0)
+            {
+                continue;
+            }
+            let slot = i.0 as usize;
+            if self.next.len() <= slot {
+                self.next.resize(slot + 1, 0);
+            }
+            for (scan, pose) in scans.scans.iter().zip(&truth.poses) {
+                if scan.stamp + eps < self.next[slot] as f64 * period {
+                    continue;
+                }
+                self.next[slot] = ((scan.stamp + eps) / period).floor() as u64 + 1;
+                self.scans.push(ScanRecord {
+                    index: self.scans.len() as u64,
+                    robot: id.0.clone(),
+                    stamp: scan.stamp,
+                    pose: *pose,
+                    angle_min: scan.angle_min,
+                    angle_increment: scan.angle_increment,
+                    range_min: scan.range_min,
+                    range_max: scan.range_max,
+                    ranges: scan.ranges.clone(),
+                });
+            }
+        }
+    }
+}
+
+fn run(
+    scenario: &Scenario,
+    opts: &RunOptions,
+    capture: Option<&ScanCapture>,
+) -> anyhow::Result<RunOutput> {
+    let mut capturer = capture.map(|capture| Capturer {
+        capture,
+        next: Vec::new(),
+        scans: Vec::new(),
+    });
     let mut sim: SimWorld = build_world(scenario, opts.threads)?;
     if let Some(path) = &opts.rrd {
         let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
@@ -84,6 +195,9 @@ pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<Ru
             }
         }
         sim.step();
+        if let Some(c) = capturer.as_mut() {
+            c.collect(&mut sim.world);
+        }
         if tick % update_every == 0 || tick + 1 == ticks {
             let sim_t = (tick + 1) as f64 * scenario.dt;
             let wall = started.elapsed().as_secs_f64().max(1e-9);
@@ -116,6 +230,7 @@ pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<Ru
         summary,
         trajectory,
         localization: robot_localization(&mut sim.world),
+        scans: capturer.map(|c| c.scans).unwrap_or_default(),
     })
 }
 

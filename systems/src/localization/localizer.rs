@@ -3,7 +3,11 @@
 //! compared on identical sensor data. Inputs are the robot's laser scans and its wheel-odometry
 //! estimate at each scan's time; nothing here reads ground truth.
 
+use super::de_filter::DeFilter;
+use super::de_mc::DeMc;
+use super::de_odometry::DeOdometry;
 use super::map::LocalizationMap;
+use super::markov_grid::MarkovGrid;
 use super::mcl::{BeamSubset, Mcl, PoseEstimate};
 use super::odometry::WheelOdometry;
 use crate::core::{KernelPool, Pose2};
@@ -14,6 +18,10 @@ use bevy_ecs::prelude::*;
 #[derive(Clone, Debug)]
 pub enum Filter {
     Mcl(Box<Mcl>),
+    MarkovGrid(Box<MarkovGrid>),
+    DeFilter(Box<DeFilter>),
+    DeMc(Box<DeMc>),
+    DeOdometry(Box<DeOdometry>),
 }
 
 impl Filter {
@@ -21,6 +29,32 @@ impl Filter {
     pub fn kind(&self) -> &'static str {
         match self {
             Filter::Mcl(_) => "mcl",
+            Filter::MarkovGrid(_) => "markov_grid",
+            Filter::DeFilter(_) => "de_filter",
+            Filter::DeMc(_) => "de_mc",
+            Filter::DeOdometry(_) => "de_odometry",
+        }
+    }
+
+    /// Beams of a scan the filter reads.
+    pub fn max_beams(&self) -> usize {
+        match self {
+            Filter::Mcl(m) => m.config.max_beams,
+            Filter::MarkovGrid(g) => g.config.max_beams,
+            Filter::DeFilter(f) => f.config.max_beams,
+            Filter::DeMc(f) => f.config.max_beams,
+            Filter::DeOdometry(f) => f.config.max_beams,
+        }
+    }
+
+    /// The latest estimate.
+    pub fn estimate(&self) -> Option<PoseEstimate> {
+        match self {
+            Filter::Mcl(m) => m.estimate,
+            Filter::MarkovGrid(g) => g.estimate,
+            Filter::DeFilter(f) => f.estimate(),
+            Filter::DeMc(f) => f.estimate(),
+            Filter::DeOdometry(f) => f.estimate,
         }
     }
 }
@@ -55,15 +89,16 @@ impl Localizer {
 
     /// Consumes one scan (beams already in the base frame) taken at odometry pose `odom`.
     fn consume(&mut self, map: &LocalizationMap, scan_stamp: f64, scan: &ScanInput, odom: &Pose2) {
-        match &mut self.filter {
-            Filter::Mcl(mcl) => {
-                let beams = scan.beams(mcl.config.max_beams);
-                if mcl.update(map, beams, odom)
-                    && let Some(e) = mcl.estimate
-                {
-                    self.publish(scan_stamp, e);
-                }
-            }
+        let beams = scan.beams(self.filter.max_beams());
+        let updated = match &mut self.filter {
+            Filter::Mcl(f) => f.update(map, beams, odom),
+            Filter::MarkovGrid(f) => f.update(map, &beams.returns(), beams.range_max, odom),
+            Filter::DeFilter(f) => f.update(map, beams, odom),
+            Filter::DeMc(f) => f.update(map, beams, odom),
+            Filter::DeOdometry(f) => f.update(&beams.returns(), odom),
+        };
+        if updated && let Some(e) = self.filter.estimate() {
+            self.publish(scan_stamp, e);
         }
     }
 
@@ -106,12 +141,7 @@ pub struct Localizers {
 
 impl Localizers {
     fn beam_counts(&self) -> Vec<usize> {
-        self.items
-            .iter()
-            .map(|l| match &l.filter {
-                Filter::Mcl(m) => m.config.max_beams,
-            })
-            .collect()
+        self.items.iter().map(|l| l.filter.max_beams()).collect()
     }
 }
 

@@ -2,14 +2,26 @@
 //! provides the belief controllers navigate by), the odometry motion model the filters share,
 //! the map localizers believe in, and the localizers themselves (Monte Carlo localization).
 
+pub mod de_filter;
+pub mod de_mc;
+pub mod de_odometry;
+pub mod de_population;
+pub mod de_tracker;
 pub mod localizer;
 pub mod map;
+pub mod markov_grid;
 pub mod mcl;
 pub mod motion_model;
 pub mod odometry;
 
+#[cfg(test)]
+mod de_tests;
+#[cfg(test)]
+pub(crate) mod test_drive;
+
 pub use localizer::{Filter, Localizer, Localizers, StampedEstimate};
 pub use map::LocalizationMap;
+pub use markov_grid::{MarkovGrid, MarkovGridConfig};
 pub use mcl::{Mcl, MclConfig, PoseEstimate};
 pub use motion_model::OdometryMotionModel;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};

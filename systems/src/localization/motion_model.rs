@@ -77,6 +77,12 @@ fn normal_pdf(x: f64, sd: f64) -> f64 {
     (-0.5 * (x / sd).powi(2)).exp() / (sd * (2.0 * PI).sqrt())
 }
 
+/// The update trigger of the filters (AMCL's `update_min_d` / `update_min_a`): true once the
+/// odometry has moved at least `min_d` (m) or turned at least `min_a` (rad) since `last`.
+pub fn moved_enough(last: &Pose2, odom: &Pose2, min_d: f64, min_a: f64) -> bool {
+    last.distance(odom) >= min_d || wrap_angle(odom.theta - last.theta).abs() >= min_a
+}
+
 impl OdometryMotionModel {
     /// The decomposed motion between odometry poses `from` and `to`, with its noise.
     pub fn delta(&self, from: &Pose2, to: &Pose2) -> OdometryDelta {

@@ -23,7 +23,7 @@ pub use resample::{BinSize, CountLimits, kld_bound, normal_quantile};
 pub use sensor_model::{BeamSubset, LaserModelParams};
 
 use super::map::LocalizationMap;
-use super::motion_model::OdometryMotionModel;
+use super::motion_model::{OdometryMotionModel, moved_enough};
 use crate::core::{Pose2, SimRng, wrap_angle};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
@@ -235,9 +235,12 @@ impl Mcl {
     /// (the first scan, or enough motion since the last update).
     pub fn update(&mut self, map: &LocalizationMap, beams: &BeamSubset, odom: &Pose2) -> bool {
         if let Some(last) = self.last_odom {
-            let moved = last.distance(odom);
-            let turned = wrap_angle(odom.theta - last.theta).abs();
-            if moved < self.config.update_min_d && turned < self.config.update_min_a {
+            if !moved_enough(
+                &last,
+                odom,
+                self.config.update_min_d,
+                self.config.update_min_a,
+            ) {
                 return false;
             }
             self.predict(&last, odom);

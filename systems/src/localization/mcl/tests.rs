@@ -2,91 +2,7 @@
 
 use super::*;
 use crate::core::stream_rng;
-use crate::sensors::LaserScan;
-use crate::world::load_map;
-
-fn hospital() -> LocalizationMap {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/maps/hospital/hospital.yaml"
-    );
-    LocalizationMap::new(load_map(std::path::Path::new(path)).unwrap(), 2.0)
-}
-
-/// A SICK LMS100-like scan (270°, 0.25°, 20 m) from `pose` with 1 cm noise.
-fn scan_at(map: &LocalizationMap, pose: &Pose2, rng: &mut SimRng) -> LaserScan {
-    let n = 1081;
-    let inc = 0.25f32.to_radians();
-    let start = -135f32.to_radians();
-    let mut ranges = vec![0.0f32; n];
-    map.rays.cast_scan(
-        [pose.x as f32, pose.y as f32],
-        pose.theta as f32 + start,
-        inc,
-        20.0,
-        &mut ranges,
-    );
-    for r in ranges.iter_mut() {
-        if r.is_finite() {
-            let e: f64 = StandardNormal.sample(rng);
-            *r += 0.01 * e as f32;
-        }
-    }
-    LaserScan {
-        stamp: 0.0,
-        angle_min: start,
-        angle_increment: inc,
-        range_min: 0.5,
-        range_max: 20.0,
-        ranges,
-    }
-}
-
-/// Drives along `route` in 0.1 m steps; odometry has 1 % translation and 2 % rotation error
-/// plus jitter. Calls `f(truth, odom, scan)` every step.
-fn drive(
-    map: &LocalizationMap,
-    route: &[[f64; 2]],
-    start_heading: f64,
-    seed: u64,
-    mut f: impl FnMut(&Pose2, &Pose2, &LaserScan),
-) {
-    let mut rng = stream_rng(seed, "test", "drive");
-    let mut truth = Pose2::new(route[0][0], route[0][1], start_heading);
-    let mut odom = Pose2::new(0.0, 0.0, 0.0);
-    for goal in &route[1..] {
-        loop {
-            let (dx, dy) = (goal[0] - truth.x, goal[1] - truth.y);
-            let dist = dx.hypot(dy);
-            if dist < 0.05 {
-                break;
-            }
-            let turn = wrap_angle(dy.atan2(dx) - truth.theta);
-            let step = if turn.abs() > 0.3 {
-                Pose2::new(0.0, 0.0, turn.clamp(-0.3, 0.3))
-            } else {
-                Pose2::new(dist.min(0.1), 0.0, turn)
-            };
-            truth = truth.compose(&step);
-            let g = |r: &mut SimRng| -> f64 { StandardNormal.sample(r) };
-            let noisy = Pose2::new(
-                step.x * 1.01 + 0.002 * g(&mut rng),
-                0.002 * g(&mut rng),
-                step.theta * 1.02 + 0.003 * g(&mut rng),
-            );
-            odom = odom.compose(&noisy);
-            let scan = scan_at(map, &truth, &mut rng);
-            f(&truth, &odom, &scan);
-        }
-    }
-}
-
-fn error(e: &PoseEstimate, truth: &Pose2) -> (f64, f64) {
-    (
-        e.pose.distance(truth),
-        wrap_angle(e.pose.theta - truth.theta).abs(),
-    )
-}
+use crate::localization::test_drive::{CORRIDOR, drive, error, hospital, scan_at};
 
 /// Defaults with motion noise and σ_hit for a well-calibrated robot and a precise laser.
 fn tuned() -> MclConfig {
@@ -104,8 +20,6 @@ fn tuned() -> MclConfig {
         ..MclConfig::default()
     }
 }
-
-const CORRIDOR: [[f64; 2]; 4] = [[2.2, 16.0], [20.0, 16.0], [20.0, 24.75], [40.0, 24.75]];
 
 #[test]
 fn tracks_from_a_gaussian_around_the_start() {

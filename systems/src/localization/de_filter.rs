@@ -1,0 +1,228 @@
+//! The differential-evolution localization filter (000_9f0113837c153763.txt §3.9.1): Moreno,
+//! Garrido & Muñoz, "Evolutionary filter for robust mobile robot global localization", RAS 54
+//! (2006), with the extensions of Martín, Muñoz, Garrido, Blanco & Moreno, "L1-norm global
+//! localization based on a differential evolution filter", WISP 2009.
+//!
+//! A population of poses, spread over free space (or around a given pose), is scored against
+//! the map by the distance between the measured ranges and the ranges expected from each pose
+//! (L1 or L2 over a beam subset, [`super::de_population::range_costs`]). At every update:
+//!
+//! 1. the population moves by the odometry since the last update (motion model samples);
+//! 2. every member is re-scored on the new scan;
+//! 3. a few generations of evolution: perturbation `v = x_i + L(x_best − x_i) + F(x_r2 − x_r3)`
+//!    (eq. 16), crossover `u_j = v_j if p_j < δ else x_ij` (eq. 17, at least one component from
+//!    v), and selection with a *rejection band*: the trial replaces the member only if its cost
+//!    is lower by more than `rejection` (relative), so noise does not shuffle the population;
+//! 4. *adaptive F*: when a generation does not improve the best member, F grows (×`f_growth`, up
+//!    to `f_max`) to push the search out of where it stalls; an improvement resets it;
+//! 5. the *discarding operator* drops the worst `discard` share of the members (down to
+//!    `min_population`), which speeds convergence;
+//! 6. estimate = the best member, covariance from the members around it; the filter declares
+//!    itself converged when the best member's cost has stayed low for a few updates, and then
+//!    runs only `tracking_generations` per update.
+//!
+//! Two additions of ours make it work on a floor as large and repetitive as the hospital's
+//! (without them the best member wanders between look-alike places): the best member is
+//! refined locally at every update ([`Population::refine_best`]), and it moves with the
+//! noise-free odometry while the others draw from the motion model.
+
+use super::de_population::{Population, RangeMetric, range_costs, three_others};
+use super::de_tracker::{CycleSettings, DeTracker};
+use super::map::LocalizationMap;
+use super::mcl::{BeamSubset, InitialBelief, PoseEstimate};
+use super::motion_model::OdometryMotionModel;
+use crate::core::{Pose2, SimRng, wrap_angle};
+use rand::RngExt;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeFilterConfig {
+    pub population: usize,
+    pub min_population: usize,
+    /// Generations per update before convergence, and after it.
+    pub generations: usize,
+    pub tracking_generations: usize,
+    /// Weight L of the pull towards the best member.
+    pub best_weight: f64,
+    /// Initial mutation factor F, its growth factor and cap (adaptive F).
+    pub f: f64,
+    pub f_growth: f64,
+    pub f_max: f64,
+    /// Crossover control δ (probability of taking a component of v).
+    pub cr: f64,
+    /// Relative rejection band of the selection.
+    pub rejection: f64,
+    /// Share of the worst members discarded per update.
+    pub discard: f64,
+    pub metric: RangeMetric,
+    pub max_beams: usize,
+    pub motion: OdometryMotionModel,
+    pub update_min_d: f64,
+    pub update_min_a: f64,
+    pub init: InitialBelief,
+    /// Converged once the best member's cost has stayed at or below `converge_cost` (mean range
+    /// error: m for L1, m² for L2) for `converge_updates` updates; lost again once it has
+    /// stayed above twice that for as many.
+    pub converge_cost: f64,
+    pub converge_updates: u32,
+    /// Local refinement of the best member at each update ([`Population::refine_best`]):
+    /// rounds, samples per round, initial spread (m, m, rad); 0 rounds disables it.
+    pub refine_rounds: usize,
+    pub refine_samples: usize,
+    pub refine_sd: [f64; 3],
+}
+
+impl Default for DeFilterConfig {
+    fn default() -> Self {
+        DeFilterConfig {
+            population: 2000,
+            min_population: 100,
+            generations: 10,
+            tracking_generations: 3,
+            best_weight: 0.3,
+            f: 0.5,
+            f_growth: 1.2,
+            f_max: 1.5,
+            cr: 0.9,
+            rejection: 0.01,
+            discard: 0.1,
+            metric: RangeMetric::L1,
+            max_beams: 60,
+            motion: OdometryMotionModel::default(),
+            update_min_d: 0.2,
+            update_min_a: std::f64::consts::PI / 6.0,
+            init: InitialBelief::Global,
+            converge_cost: 0.1,
+            converge_updates: 3,
+            refine_rounds: 4,
+            refine_samples: 32,
+            refine_sd: [0.2, 0.2, 0.05],
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct DeFilter {
+    pub config: DeFilterConfig,
+    /// Population, convergence state and estimate.
+    pub tracker: DeTracker,
+    /// The current (adaptive) mutation factor.
+    pub f: f64,
+}
+
+impl DeFilter {
+    pub fn new(config: DeFilterConfig, map: &LocalizationMap, rng: SimRng) -> Self {
+        DeFilter {
+            f: config.f,
+            tracker: DeTracker::new(config.population, &config.init, map, rng),
+            config,
+        }
+    }
+
+    pub fn estimate(&self) -> Option<PoseEstimate> {
+        self.tracker.estimate
+    }
+
+    /// Consumes a scan taken at odometry pose `odom`. Returns true if the filter updated.
+    pub fn update(&mut self, map: &LocalizationMap, beams: &BeamSubset, odom: &Pose2) -> bool {
+        let c = &self.config;
+        let settings = CycleSettings {
+            motion: &c.motion,
+            update_min_d: c.update_min_d,
+            update_min_a: c.update_min_a,
+            metric: c.metric,
+            converge_cost: c.converge_cost,
+            converge_updates: c.converge_updates,
+            refine_rounds: c.refine_rounds,
+            refine_samples: c.refine_samples,
+            refine_sd: c.refine_sd,
+        };
+        let f = &mut self.f;
+        self.tracker
+            .update(map, beams, odom, &settings, |t, converged| {
+                let gens = if converged {
+                    c.tracking_generations
+                } else {
+                    c.generations
+                };
+                for _ in 0..gens {
+                    generation(t, c, f, map, beams);
+                }
+                discard(&mut t.population, c);
+            })
+    }
+}
+
+/// One generation: perturbation, crossover, evaluation of the trials, selection with the
+/// rejection band, adaptation of `f`. Returns whether the best cost improved.
+fn generation(
+    t: &mut DeTracker,
+    c: &DeFilterConfig,
+    f: &mut f64,
+    map: &LocalizationMap,
+    beams: &BeamSubset,
+) -> bool {
+    let pop = &mut t.population;
+    let n = pop.len();
+    if n < 4 {
+        return false;
+    }
+    let b = pop.best();
+    let best_cost = pop.costs[b];
+    let xb = pop.poses[b];
+    let mut trials = Vec::with_capacity(n);
+    for i in 0..n {
+        let x = pop.poses[i];
+        let [_, r2, r3] = three_others(&mut t.rng, n, i);
+        let (p2, p3) = (pop.poses[r2], pop.poses[r3]);
+        let v = [
+            x[0] + c.best_weight * (xb[0] - x[0]) + *f * (p2[0] - p3[0]),
+            x[1] + c.best_weight * (xb[1] - x[1]) + *f * (p2[1] - p3[1]),
+            x[2] + c.best_weight * wrap_angle(xb[2] - x[2]) + *f * wrap_angle(p2[2] - p3[2]),
+        ];
+        let forced = t.rng.random_range(0..3);
+        let mut u = x;
+        for j in 0..3 {
+            if j == forced || t.rng.random::<f64>() < c.cr {
+                u[j] = v[j];
+            }
+        }
+        u[2] = wrap_angle(u[2]);
+        trials.push(u);
+    }
+    let mut costs = vec![0.0; n];
+    range_costs(map, beams, c.metric, &trials, &mut costs);
+    t.evaluations += n as u64;
+    for i in 0..n {
+        let old = pop.costs[i];
+        if costs[i] < old - c.rejection * old.abs() {
+            pop.poses[i] = trials[i];
+            pop.costs[i] = costs[i];
+        }
+    }
+    let improved = pop.costs[pop.best()] < best_cost;
+    *f = if improved {
+        c.f
+    } else {
+        (*f * c.f_growth).min(c.f_max)
+    };
+    improved
+}
+
+/// Drops the worst `discard` share of the members (never below `min_population`).
+fn discard(pop: &mut Population, c: &DeFilterConfig) {
+    let n = pop.len();
+    let keep = ((n as f64 * (1.0 - c.discard)).ceil() as usize)
+        .max(c.min_population)
+        .min(n);
+    if keep == n {
+        return;
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(a.cmp(&b)));
+    order.truncate(keep);
+    order.sort_unstable();
+    *pop = Population {
+        poses: order.iter().map(|&i| pop.poses[i]).collect(),
+        costs: order.iter().map(|&i| pop.costs[i]).collect(),
+    };
+}

@@ -1,0 +1,126 @@
+//! The update cycle both DE localizers share ([`super::de_filter`], [`super::de_mc`];
+//! 000_9f0113837c153763.txt §3.9): move the population by odometry, score it on the new scan,
+//! refine the best member locally, let the method evolve the population, keep the elite, update
+//! the convergence state and the estimate.
+
+use super::de_population::{ESTIMATE_FLOOR, Gate, Population, RangeMetric, convergence};
+use super::map::LocalizationMap;
+use super::mcl::{BeamSubset, InitialBelief, PoseEstimate};
+use super::motion_model::{OdometryMotionModel, moved_enough};
+use crate::core::{Pose2, SimRng};
+
+/// The settings of the shared cycle (fields of each method's configuration).
+#[derive(Clone, Copy, Debug)]
+pub struct CycleSettings<'a> {
+    pub motion: &'a OdometryMotionModel,
+    pub update_min_d: f64,
+    pub update_min_a: f64,
+    pub metric: RangeMetric,
+    pub converge_cost: f64,
+    pub converge_updates: u32,
+    pub refine_rounds: usize,
+    pub refine_samples: usize,
+    pub refine_sd: [f64; 3],
+}
+
+/// The state of a DE localizer apart from its method's own parameters.
+#[derive(Clone, Debug)]
+pub struct DeTracker {
+    pub population: Population,
+    pub converged: bool,
+    /// The estimate, carried along by odometry between updates.
+    tracked: Option<Pose2>,
+    /// Consecutive updates on the other side of the convergence threshold.
+    streak: u32,
+    pub rng: SimRng,
+    last_odom: Option<Pose2>,
+    pub updates: u64,
+    /// Cost evaluations so far.
+    pub evaluations: u64,
+    pub estimate: Option<PoseEstimate>,
+}
+
+impl DeTracker {
+    /// `n` members drawn from the initial belief.
+    pub fn new(n: usize, init: &InitialBelief, map: &LocalizationMap, mut rng: SimRng) -> Self {
+        let population = Population::initial(n, init, map, &mut rng);
+        DeTracker {
+            population,
+            converged: false,
+            tracked: None,
+            streak: 0,
+            rng,
+            last_odom: None,
+            updates: 0,
+            evaluations: 0,
+            estimate: None,
+        }
+    }
+
+    /// While converged, the estimate follows the best member within 1 m and 0.3 rad of where the
+    /// last estimate has moved to.
+    fn gate(&self) -> Option<Gate> {
+        let t = self.tracked.filter(|_| self.converged)?;
+        Some(Gate {
+            centre: [t.x, t.y, t.theta],
+            radius: 1.0,
+            angle: 0.3,
+        })
+    }
+
+    /// Consumes a scan taken at odometry pose `odom`; `evolve(tracker, converged)` runs the
+    /// method's generations on the scored population. Returns true if the filter updated (the
+    /// first scan, or enough motion since the last update).
+    pub fn update(
+        &mut self,
+        map: &LocalizationMap,
+        beams: &BeamSubset,
+        odom: &Pose2,
+        s: &CycleSettings,
+        evolve: impl FnOnce(&mut DeTracker, bool),
+    ) -> bool {
+        if let Some(last) = self.last_odom {
+            if !moved_enough(&last, odom, s.update_min_d, s.update_min_a) {
+                return false;
+            }
+            let d = s.motion.delta(&last, odom);
+            let lead = self.population.leader(self.gate().as_ref());
+            self.population.move_by(s.motion, &d, lead, &mut self.rng);
+            // the estimate moves with the noise-free odometry
+            self.tracked = self
+                .tracked
+                .map(|t| t.compose(&last.inverse().compose(odom)));
+        }
+        self.last_odom = Some(*odom);
+        if beams.is_empty() {
+            return true;
+        }
+        self.population.evaluate(map, beams, s.metric);
+        self.evaluations += self.population.len() as u64;
+        let lead = self.population.leader(self.gate().as_ref());
+        self.evaluations += self.population.refine_best(
+            map,
+            beams,
+            s.metric,
+            lead,
+            s.refine_rounds,
+            s.refine_samples,
+            s.refine_sd,
+            &mut self.rng,
+        );
+        let elite = (self.population.poses[lead], self.population.costs[lead]);
+        evolve(self, self.converged);
+        let lead = self.population.keep_elite(elite, self.gate().as_ref());
+        (self.converged, self.streak) = convergence(
+            self.converged,
+            self.streak,
+            self.population.costs[lead],
+            s.converge_cost,
+            s.converge_updates,
+        );
+        self.updates += 1;
+        self.estimate = self.population.estimate(lead, 0.5, 0.2, ESTIMATE_FLOOR);
+        self.tracked = self.estimate.map(|e| e.pose);
+        true
+    }
+}

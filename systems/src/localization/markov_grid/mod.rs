@@ -1,0 +1,383 @@
+//! Markov grid localization: a histogram Bayes filter over (x, y, θ) (Burgard, Fox, Hennig &
+//! Schmidt, "Estimating the absolute position of a mobile robot using position probability
+//! grids", AAAI 1996; Probabilistic Robotics §8.2, Table 8.1). The belief is a probability per
+//! cell of a coarse lattice (default 0.25 m × 0.25 m × 10°) over the free space of the map:
+//!
+//! - prediction ([`prediction`]): every cell's mass moves by the odometry motion as seen from
+//!   its heading (trilinear split), then a Gaussian blur adds the rest of the motion noise of
+//!   the shared odometry model (α1..α4);
+//! - correction ([`correction`]): the likelihood field on the map's distance field, every beam
+//!   endpoint projected from every cell centre; log-likelihoods summed over beams, optionally
+//!   tempered by `likelihood_exponent` (the beams of a scan are not independent, Thrun §6.4.3);
+//! - a small uniform share (`uniform_mix`) keeps every free cell possible, so a kidnapped
+//!   robot can be found again;
+//! - the estimate is the most probable cell refined by the weighted mean of its 3 × 3 × 3
+//!   neighbourhood, with that neighbourhood's covariance (plus the cells' own extent), then
+//!   moved within about a cell to where the scan fits the map best ([`refine`]); the belief
+//!   itself stays a histogram.
+//!
+//! Like MCL, it updates only after a minimum travel or turn of the odometry. Layers (θ) are
+//! scored in parallel; each layer's result depends on that layer only.
+
+pub mod correction;
+pub mod layout;
+pub mod prediction;
+pub mod refine;
+
+use super::map::LocalizationMap;
+use super::mcl::{InitialBelief, LaserModelParams, PoseEstimate};
+use super::motion_model::{OdometryMotionModel, moved_enough};
+use crate::core::{Pose2, wrap_angle};
+use correction::PaddedField;
+use layout::Layout;
+use rayon::prelude::*;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarkovGridConfig {
+    /// Cell size (m).
+    pub resolution: f64,
+    /// θ bins over the full turn.
+    pub angular_bins: usize,
+    pub max_beams: usize,
+    pub laser: LaserModelParams,
+    pub motion: OdometryMotionModel,
+    /// Exponent on the scan likelihood (1 = beams independent).
+    pub likelihood_exponent: f64,
+    /// Share of the belief spread uniformly over free space after each correction.
+    pub uniform_mix: f64,
+    pub update_min_d: f64,
+    pub update_min_a: f64,
+    pub init: InitialBelief,
+}
+
+impl Default for MarkovGridConfig {
+    fn default() -> Self {
+        MarkovGridConfig {
+            resolution: 0.25,
+            angular_bins: 36,
+            max_beams: 60,
+            laser: LaserModelParams {
+                sigma_hit: 0.25,
+                ..LaserModelParams::default()
+            },
+            motion: OdometryMotionModel::default(),
+            likelihood_exponent: 1.0,
+            uniform_mix: 1e-6,
+            update_min_d: 0.25,
+            update_min_a: 10f64.to_radians(),
+            init: InitialBelief::Global,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct MarkovGrid {
+    pub config: MarkovGridConfig,
+    pub layout: Layout,
+    /// Probability per cell, θ-layer-major (k · ny + j) · nx + i; sums to 1.
+    pub belief: Vec<f32>,
+    scratch: Vec<f32>,
+    tmp: Vec<f32>,
+    field: Option<PaddedField>,
+    last_odom: Option<Pose2>,
+    pub updates: u64,
+    pub estimate: Option<PoseEstimate>,
+}
+
+/// A cell centre `(x, y, heading offset, belief)` in the estimate's neighbourhood.
+type WeightedCell = (f64, f64, f64, f64);
+
+impl MarkovGrid {
+    pub fn new(config: MarkovGridConfig, map: &LocalizationMap) -> Self {
+        let layout = Layout::new(&map.grid, config.resolution, config.angular_bins);
+        let mut g = MarkovGrid {
+            belief: vec![0.0; layout.len()],
+            scratch: vec![0.0; layout.len()],
+            tmp: Vec::new(),
+            layout,
+            config,
+            field: None,
+            last_odom: None,
+            updates: 0,
+            estimate: None,
+        };
+        g.initialise();
+        g.estimate = g.estimate_pose();
+        g
+    }
+
+    fn initialise(&mut self) {
+        let l = &self.layout;
+        let layer = l.layer();
+        match self.config.init {
+            InitialBelief::Global => {}
+            InitialBelief::Gaussian { pose, sd } => {
+                let sx = sd[0].max(0.5 * l.resolution);
+                let sy = sd[1].max(0.5 * l.resolution);
+                let st = sd[2].max(0.5 * l.theta_step());
+                for k in 0..l.n_theta {
+                    let dt = wrap_angle(l.theta(k) - pose.theta) / st;
+                    for s in &l.spans {
+                        for i in s.i0..s.i0 + s.len {
+                            let (x, y) = l.centre(i as usize, s.j as usize);
+                            let (dx, dy) = ((x - pose.x) / sx, (y - pose.y) / sy);
+                            let e = -0.5 * (dx * dx + dy * dy + dt * dt);
+                            self.belief[k * layer + s.j as usize * l.nx + i as usize] =
+                                e.exp() as f32;
+                        }
+                    }
+                }
+            }
+        }
+        if !self.normalise() {
+            self.fill_uniform();
+        }
+    }
+
+    fn fill_uniform(&mut self) {
+        let l = &self.layout;
+        let n = (l.free_count() * l.n_theta).max(1) as f32;
+        self.belief.iter_mut().for_each(|v| *v = 0.0);
+        for k in 0..l.n_theta {
+            for s in &l.spans {
+                let a = k * l.layer() + s.j as usize * l.nx + s.i0 as usize;
+                self.belief[a..a + s.len as usize]
+                    .iter_mut()
+                    .for_each(|v| *v = 1.0 / n);
+            }
+        }
+    }
+
+    /// Scales the belief to sum 1; false if it holds no mass.
+    fn normalise(&mut self) -> bool {
+        let total: f64 = self.belief.iter().map(|&v| v as f64).sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return false;
+        }
+        let s = (1.0 / total) as f32;
+        self.belief.iter_mut().for_each(|v| *v *= s);
+        true
+    }
+
+    /// Prediction for the odometry motion `from` → `to`.
+    pub fn predict(&mut self, from: &Pose2, to: &Pose2) {
+        let d = self.config.motion.delta(from, to);
+        prediction::shift(&self.layout, &d, &self.belief, &mut self.scratch);
+        std::mem::swap(&mut self.belief, &mut self.scratch);
+        // the trilinear split already spreads ~1/6 cell² on average
+        let extra = |sigma: f64| (sigma * sigma - 1.0 / 6.0).max(0.0).sqrt();
+        let s_xy = extra(d.sd_trans.hypot(d.trans * d.sd_rot1) / self.layout.resolution);
+        if s_xy > 0.25 {
+            let k = prediction::kernel(s_xy);
+            prediction::blur_xy(&self.layout, &k, &mut self.belief, &mut self.tmp);
+        }
+        let s_th = extra(d.sd_rot1.hypot(d.sd_rot2) / self.layout.theta_step());
+        if s_th > 0.25 {
+            let k = prediction::kernel(s_th);
+            prediction::blur_theta(&self.layout, &k, &self.belief, &mut self.scratch);
+            std::mem::swap(&mut self.belief, &mut self.scratch);
+        }
+        if !self.normalise() {
+            self.fill_uniform();
+        }
+    }
+
+    /// Log-likelihood of the scan endpoints `points` (base frame) for every cell, into the
+    /// scratch buffer.
+    fn score(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+        let reach = points
+            .iter()
+            .map(|p| (p[0] as f64).hypot(p[1] as f64))
+            .fold(0.0, f64::max);
+        if self.field.as_ref().is_none_or(|f| f.reach < reach) {
+            self.field = Some(PaddedField::new(&map.field, reach.max(1.0)));
+        }
+        let laser = self.config.laser;
+        let tables: Vec<[f32; 256]> = points
+            .iter()
+            .map(|p| {
+                let range = (p[0] as f64).hypot(p[1] as f64);
+                correction::beam_table(
+                    &map.field,
+                    &laser,
+                    range_max as f64,
+                    self.layout.resolution,
+                    self.layout.theta_step(),
+                    range,
+                )
+            })
+            .collect();
+        let field = self.field.as_ref().expect("built above");
+        let layout = &self.layout;
+        self.scratch
+            .par_chunks_mut(layout.layer())
+            .enumerate()
+            .for_each(|(k, out)| {
+                out.iter_mut().for_each(|v| *v = 0.0);
+                let (s, c) = layout.theta(k).sin_cos();
+                let offsets: Vec<isize> = points
+                    .iter()
+                    .map(|p| {
+                        let (x, y) = (p[0] as f64, p[1] as f64);
+                        field.offset(c * x - s * y, s * x + c * y)
+                    })
+                    .collect();
+                correction::layer_log_likelihood(field, &tables, layout, &offsets, out);
+            });
+    }
+
+    /// Correction by a scan's endpoints (base frame, max-range readings left out).
+    pub fn correct(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+        if points.is_empty() {
+            return;
+        }
+        self.score(map, points, range_max);
+        let lambda = self.config.likelihood_exponent as f32;
+        let best = self
+            .belief
+            .iter()
+            .zip(&self.scratch)
+            .filter(|(p, _)| **p > 0.0)
+            .map(|(_, l)| *l)
+            .fold(f32::NEG_INFINITY, f32::max);
+        if best.is_finite() {
+            for (p, &l) in self.belief.iter_mut().zip(&self.scratch) {
+                if *p > 0.0 {
+                    *p *= (lambda * (l - best)).exp();
+                }
+            }
+        }
+        if !self.normalise() {
+            self.fill_uniform();
+        }
+        let mix = self.config.uniform_mix as f32;
+        if mix > 0.0 {
+            let l = &self.layout;
+            let u = mix / (l.free_count() * l.n_theta).max(1) as f32;
+            for k in 0..l.n_theta {
+                for s in &l.spans {
+                    let a = k * l.layer() + s.j as usize * l.nx + s.i0 as usize;
+                    self.belief[a..a + s.len as usize]
+                        .iter_mut()
+                        .for_each(|v| *v = (1.0 - mix) * *v + u);
+                }
+            }
+        }
+    }
+
+    /// Consumes a scan (endpoints in the base frame) taken at odometry pose `odom`. Returns true
+    /// if the filter updated.
+    pub fn update(
+        &mut self,
+        map: &LocalizationMap,
+        points: &[[f32; 2]],
+        range_max: f32,
+        odom: &Pose2,
+    ) -> bool {
+        if let Some(last) = self.last_odom {
+            if !moved_enough(
+                &last,
+                odom,
+                self.config.update_min_d,
+                self.config.update_min_a,
+            ) {
+                return false;
+            }
+            self.predict(&last, odom);
+        }
+        self.last_odom = Some(*odom);
+        self.correct(map, points, range_max);
+        self.updates += 1;
+        self.estimate = self.estimate_pose().map(|mut e| {
+            e.pose = refine::refine_pose(
+                map,
+                &self.config.laser,
+                points,
+                range_max,
+                e.pose,
+                self.layout.resolution,
+                self.layout.theta_step(),
+            );
+            e
+        });
+        true
+    }
+
+    /// The most probable cell, refined over its 3 × 3 × 3 neighbourhood.
+    pub fn estimate_pose(&self) -> Option<PoseEstimate> {
+        let l = &self.layout;
+        let (best, &p) = self
+            .belief
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)))?;
+        if p <= 0.0 {
+            return None;
+        }
+        let layer = l.layer();
+        let (k0, rest) = (best / layer, best % layer);
+        let (j0, i0) = (rest / l.nx, rest % l.nx);
+        let mut cells = Vec::with_capacity(27);
+        for dk in -1..=1isize {
+            let k = (k0 as isize + dk).rem_euclid(l.n_theta as isize) as usize;
+            for dj in -1..=1isize {
+                for di in -1..=1isize {
+                    let (i, j) = (i0 as isize + di, j0 as isize + dj);
+                    if i < 0 || j < 0 || i >= l.nx as isize || j >= l.ny as isize {
+                        continue;
+                    }
+                    let (i, j) = (i as usize, j as usize);
+                    let w = self.belief[k * layer + j * l.nx + i] as f64;
+                    if w > 0.0 {
+                        let (x, y) = l.centre(i, j);
+                        // heading relative to the best cell's, so the mean does not wrap
+                        cells.push((x, y, dk as f64 * l.theta_step(), w));
+                    }
+                }
+            }
+        }
+        let total: f64 = cells.iter().map(|c| c.3).sum();
+        let mean = |f: &dyn Fn(&WeightedCell) -> f64| {
+            cells.iter().map(|c| c.3 * f(c)).sum::<f64>() / total
+        };
+        let (mx, my, mt) = (mean(&|c| c.0), mean(&|c| c.1), mean(&|c| c.2));
+        let d = |c: &WeightedCell| [c.0 - mx, c.1 - my, c.2 - mt];
+        let mut cov = [[0.0; 3]; 3];
+        for (a, row) in cov.iter_mut().enumerate() {
+            for (b, v) in row.iter_mut().enumerate() {
+                *v = mean(&|c| d(c)[a] * d(c)[b]);
+            }
+        }
+        cov[0][0] += l.resolution * l.resolution / 12.0;
+        cov[1][1] += l.resolution * l.resolution / 12.0;
+        cov[2][2] += l.theta_step() * l.theta_step() / 12.0;
+        Some(PoseEstimate {
+            pose: Pose2::new(mx, my, wrap_angle(l.theta(k0) + mt)),
+            covariance: cov,
+            weight: total,
+        })
+    }
+
+    /// Probability mass within `radius` (m) and `angle` (rad) of a pose.
+    pub fn mass_near(&self, pose: &Pose2, radius: f64, angle: f64) -> f64 {
+        let l = &self.layout;
+        let mut m = 0.0;
+        for k in 0..l.n_theta {
+            if wrap_angle(l.theta(k) - pose.theta).abs() > angle {
+                continue;
+            }
+            for s in &l.spans {
+                for i in s.i0..s.i0 + s.len {
+                    let (x, y) = l.centre(i as usize, s.j as usize);
+                    if (x - pose.x).hypot(y - pose.y) <= radius {
+                        m += self.belief[k * l.layer() + s.j as usize * l.nx + i as usize] as f64;
+                    }
+                }
+            }
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests;
