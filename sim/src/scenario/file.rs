@@ -184,6 +184,7 @@ pub struct EncoderFile {
 #[serde(rename_all = "snake_case")]
 pub enum EventType {
     Waypoints,
+    #[serde(alias = "kidnap")]
     Teleport,
     SensorFault,
 }

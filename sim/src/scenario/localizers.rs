@@ -71,6 +71,8 @@ impl LocalizerType {
                 "lambda_short",
                 "recovery_alpha_slow",
                 "recovery_alpha_fast",
+                "injection_candidates",
+                "recovery_ratio",
             ],
             LocalizerType::MarkovGrid => &[
                 "max_beams",
@@ -88,6 +90,7 @@ impl LocalizerType {
                 "angular_bins",
                 "likelihood_exponent",
                 "uniform_mix",
+                "selective_threshold",
             ],
             LocalizerType::DeFilter => &[
                 "max_beams",
@@ -211,6 +214,8 @@ pub struct LocalizerFile {
     pub alpha: Option<[f64; 4]>,
     pub recovery_alpha_slow: Option<f64>,
     pub recovery_alpha_fast: Option<f64>,
+    pub injection_candidates: Option<usize>,
+    pub recovery_ratio: Option<f64>,
     pub init: Option<InitType>,
     pub init_pose: Option<PointOrPlace>,
     /// Standard deviations of the initial Gaussian [x (m), y (m), yaw (rad)].
@@ -220,6 +225,7 @@ pub struct LocalizerFile {
     pub angular_bins: Option<usize>,
     pub likelihood_exponent: Option<f64>,
     pub uniform_mix: Option<f64>,
+    pub selective_threshold: Option<f64>,
     // de_filter, de_mc
     pub population: Option<usize>,
     pub min_population: Option<usize>,
@@ -278,6 +284,8 @@ impl LocalizerFile {
             alpha,
             recovery_alpha_slow,
             recovery_alpha_fast,
+            injection_candidates,
+            recovery_ratio,
             init,
             init_pose,
             init_sd,
@@ -285,6 +293,7 @@ impl LocalizerFile {
             angular_bins,
             likelihood_exponent,
             uniform_mix,
+            selective_threshold,
             population,
             min_population,
             generations,
@@ -621,6 +630,20 @@ fn resolve_mcl(
             l.recovery_alpha_fast,
             d.recovery_alpha_fast,
         )?,
+        recovery_ratio: match l.recovery_ratio {
+            Some(v) => c.range(&p.key("recovery_ratio"), v, Some(0.0), Some(1.0), true)?,
+            None => d.recovery_ratio,
+        },
+        injection_candidates: match l.injection_candidates {
+            Some(0) => 0,
+            _ => f.count(
+                "injection_candidates",
+                l.injection_candidates,
+                d.injection_candidates,
+                1,
+                10_000_000,
+            )?,
+        },
         init: f.init(start, pose)?,
         bins: d.bins,
     })
@@ -650,6 +673,11 @@ fn resolve_markov_grid(
             None => d.likelihood_exponent,
         },
         uniform_mix: f.prob("uniform_mix", l.uniform_mix, d.uniform_mix)?,
+        selective_threshold: f.prob(
+            "selective_threshold",
+            l.selective_threshold,
+            d.selective_threshold,
+        )?,
         update_min_d: f.nonneg("update_min_d", l.update_min_d, d.update_min_d)?,
         update_min_a: f.nonneg("update_min_a", l.update_min_a, d.update_min_a)?,
         init: f.init(start, pose)?,

@@ -135,6 +135,7 @@ impl DeFilter {
             refine_rounds: c.refine_rounds,
             refine_samples: c.refine_samples,
             refine_sd: c.refine_sd,
+            reseed: c.population,
         };
         let f = &mut self.f;
         self.tracker

@@ -113,6 +113,7 @@ impl DeMc {
             refine_rounds: c.refine_rounds,
             refine_samples: c.refine_samples,
             refine_sd: c.refine_sd,
+            reseed: c.population,
         };
         let acceptance = &mut self.acceptance;
         self.tracker

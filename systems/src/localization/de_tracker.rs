@@ -1,7 +1,8 @@
 //! The update cycle both DE localizers share ([`super::de_filter`], [`super::de_mc`];
 //! 000_9f0113837c153763.txt §3.9): move the population by odometry, score it on the new scan,
 //! refine the best member locally, let the method evolve the population, keep the elite, update
-//! the convergence state and the estimate.
+//! the convergence state and the estimate; once a converged filter is lost, a fresh population
+//! spread over the whole floor searches again.
 
 use super::de_population::{ESTIMATE_FLOOR, Gate, Population, RangeMetric, convergence};
 use super::map::LocalizationMap;
@@ -21,6 +22,8 @@ pub struct CycleSettings<'a> {
     pub refine_rounds: usize,
     pub refine_samples: usize,
     pub refine_sd: [f64; 3],
+    /// Members of a fresh global population when the filter loses convergence (0: never).
+    pub reseed: usize,
 }
 
 /// The state of a DE localizer apart from its method's own parameters.
@@ -111,6 +114,7 @@ impl DeTracker {
         let elite = (self.population.poses[lead], self.population.costs[lead]);
         evolve(self, self.converged);
         let lead = self.population.keep_elite(elite, self.gate().as_ref());
+        let was_converged = self.converged;
         (self.converged, self.streak) = convergence(
             self.converged,
             self.streak,
@@ -121,6 +125,14 @@ impl DeTracker {
         self.updates += 1;
         self.estimate = self.population.estimate(lead, 0.5, 0.2, ESTIMATE_FLOOR);
         self.tracked = self.estimate.map(|e| e.pose);
+        if was_converged && !self.converged && s.reseed > 0 {
+            // lost (kidnapped, or slid off to a look-alike place): search the whole floor
+            // again, the best member kept so a false alarm costs nothing
+            let best = (self.population.poses[lead], self.population.costs[lead]);
+            self.population =
+                Population::initial(s.reseed, &InitialBelief::Global, map, &mut self.rng);
+            (self.population.poses[0], self.population.costs[0]) = best;
+        }
         true
     }
 }

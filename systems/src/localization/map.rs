@@ -44,6 +44,13 @@ impl LocalizationMap {
         self.free.len()
     }
 
+    /// Whether the point (m) lies on a free cell of the map.
+    pub fn is_free(&self, x: f64, y: f64) -> bool {
+        self.grid
+            .cell_of(x, y)
+            .is_some_and(|(c, r)| self.grid.get(c, r) == Cell::Free)
+    }
+
     /// A pose uniform over free space with a uniform heading, from uniform draws in [0, 1).
     /// With no free cell at all, a pose uniform over the whole grid.
     pub fn random_free_pose(&self, u: &mut dyn FnMut() -> f64) -> (f64, f64, f64) {

@@ -1,5 +1,6 @@
 //! Localization end to end: MCL on the hospital scenario (global initialisation converges and then
-//! tracks), TUM trajectories, and scenario errors of the localizer list.
+//! tracks), every localizer type on the hospital patrol, recovery from a kidnapping, a laser fault
+//! window, TUM trajectories, and scenario errors of the localizer list.
 
 use crate::common::*;
 use sim::scenario::load_scenario;
@@ -20,6 +21,9 @@ fn run(sc: &sim::Scenario) -> sim::RunOutput {
 fn mcl_converges_from_global_initialisation_and_tracks_on_the_hospital_patrol() {
     let mut sc = load_scenario(&bundled("hospital_patrol")).unwrap();
     sc.duration = 60.0;
+    for r in &mut sc.robots {
+        r.localizers.retain(|l| l.name.starts_with("mcl"));
+    }
     let out = run(&sc);
     for r in &out.summary.robots {
         for name in ["mcl", "mcl_global"] {
@@ -52,6 +56,135 @@ fn mcl_converges_from_global_initialisation_and_tracks_on_the_hospital_patrol() 
         "tracked_fraction",
     ] {
         assert!(m[key].is_number(), "{key} in {m}");
+    }
+}
+
+#[test]
+fn hospital_patrol_runs_every_localizer_type_on_every_robot() {
+    let mut sc = load_scenario(&bundled("hospital_patrol")).unwrap();
+    sc.duration = 20.0;
+    let out = run(&sc);
+    for r in &out.summary.robots {
+        let names: Vec<&str> = r.localization.keys().map(|k| k.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "de_filter",
+                "de_odometry",
+                "markov_grid",
+                "mcl",
+                "mcl_global"
+            ],
+            "{}",
+            r.name
+        );
+        for (name, m) in &r.localization {
+            assert!(m.estimates > 10, "{} {name}: {m:?}", r.name);
+            assert!(m.ate_rmse_m.is_some() && m.rpe_trans_m.is_some(), "{name}");
+        }
+        // the grid covers the whole floor: it finds every robot within seconds
+        let grid = &r.localization["markov_grid"];
+        assert!(
+            grid.converged_after_s.is_some_and(|t| t < 10.0),
+            "{}: {grid:?}",
+            r.name
+        );
+        // scan-to-scan odometry drifts, but slowly
+        let odo = &r.localization["de_odometry"];
+        assert!(odo.rpe_trans_m.unwrap() < 0.02, "{}: {odo:?}", r.name);
+    }
+}
+
+/// A robot carried off to another corridor (`kidnap`, at 20 s) is found again by every global
+/// localizer within 30 s; during a laser fault window (8–11 s, in a straight corridor) the localizers
+/// wait, then go on.
+#[test]
+fn kidnapped_robot_is_recovered_within_30_s() {
+    let text = r#"
+name = "kidnap"
+seed = 3
+dt = 0.05
+duration = 55.0
+[map]
+file = "../maps/hospital/hospital.yaml"
+places = "../maps/hospital/places.toml"
+[[robots]]
+name = "r1"
+start = "charger_1"
+footprint = { circle = 0.3 }
+behaviour = { type = "waypoints", loop = true, speed = 0.8, points = [
+  "corridor_main_cross_w", "corridor_north_cross_w", "corridor_north_c",
+  "corridor_north_cross_w", "corridor_main_cross_w", "charger_1",
+] }
+[robots.sensors.laser]
+preset = "sick_lms100"
+mount = [0.15, 0.0, 0.0]
+[robots.sensors.encoder]
+slip_std = 0.005
+[[robots.localization]]
+type = "mcl"
+init = "pose"
+alpha = [0.01, 0.01, 0.01, 0.01]
+sigma_hit = 0.1
+[[robots.localization]]
+type = "markov_grid"
+init = "pose"
+alpha = [0.01, 0.01, 0.01, 0.01]
+[[robots.localization]]
+type = "de_filter"
+init = "pose"
+alpha = [0.01, 0.01, 0.01, 0.01]
+[[events]]
+at = 20.0
+type = "kidnap"
+robot = "r1"
+pose = "corridor_main_c"
+[[events]]
+at = 8.0
+type = "sensor_fault"
+robot = "r1"
+sensor = "laser"
+active = true
+[[events]]
+at = 11.0
+type = "sensor_fault"
+robot = "r1"
+sensor = "laser"
+active = false
+"#;
+    let out = run(&scenario(text));
+    let kidnap = 20.0;
+    for (name, samples) in &out.localization[0].localizers {
+        let before: Vec<_> = samples.iter().filter(|s| s.t < kidnap).collect();
+        assert!(
+            before.iter().all(|s| s.position_error() < 0.2),
+            "{name} tracks before the kidnapping"
+        );
+        // the kidnapping is noticed: the estimate is far off right after it
+        let first_after = samples.iter().find(|s| s.t > kidnap).unwrap();
+        assert!(first_after.position_error() > 5.0, "{name}");
+        // recovered: from some time within 30 s on, every estimate is within 0.2 m and 5°
+        let after: Vec<_> = samples.iter().filter(|s| s.t > kidnap).collect();
+        let ok = |s: &&systems::eval::Sample| {
+            s.position_error() < 0.2
+                && systems::core::wrap_angle(s.estimate.theta - s.truth.theta).abs()
+                    < 5f64.to_radians()
+        };
+        let from = (0..after.len()).find(|&i| after[i..].iter().all(ok));
+        let recovered = from.map(|i| after[i].t - kidnap);
+        assert!(
+            recovered.is_some_and(|t| t <= 30.0),
+            "{name}: recovered after {recovered:?} s"
+        );
+        // no update without scans in the fault window (the last one may land in its first tick)
+        assert!(
+            !samples.iter().any(|s| s.t > 8.1 && s.t < 11.0),
+            "{name} updated while the laser was off"
+        );
+        assert!(
+            samples.iter().any(|s| s.t > 11.0 && s.t < 12.0),
+            "{name} resumes"
+        );
     }
 }
 
@@ -141,4 +274,65 @@ fn localizer_errors_name_the_key() {
          [[robots.localization]]\ntype = \"mcl\"\n"
     );
     expect_error(&text, &["robots[0].localization", "sensors.laser"]);
+}
+
+#[test]
+fn grid_and_de_localizer_errors_name_the_key() {
+    // a key of another localizer type
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"markov_grid\"\npopulation = 100"),
+        &[
+            "robots[0].localization[0].population",
+            "does not apply to a `markov_grid` localizer",
+            "angular_bins",
+        ],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"de_filter\"\nmin_particles = 10"),
+        &["min_particles", "does not apply to a `de_filter`"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"markov_grid\"\nangular_bins = 2"),
+        &["angular_bins", "[4, 720]"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"markov_grid\"\nresolution = 0.0"),
+        &["resolution"],
+    );
+    expect_error(
+        &with_localizer(
+            "[[robots.localization]]\ntype = \"de_filter\"\npopulation = 50\nmin_population = 80",
+        ),
+        &["min_population", "exceeds population"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"de_filter\"\nmetric = \"l3\""),
+        &["metric", "l3"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"de_mc\"\ntemperature = -1.0"),
+        &["temperature"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"de_odometry\"\ninit = \"global\""),
+        &[
+            "robots[0].localization[0].init",
+            "de_odometry",
+            "init = \"pose\"",
+        ],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"de_odometry\"\nmatcher = \"icp\""),
+        &["matcher", "icp"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"mcl\"\ninjection_candidates = -5"),
+        &["injection_candidates"],
+    );
+    // every type parses with its defaults
+    for t in ["mcl", "markov_grid", "de_filter", "de_mc", "de_odometry"] {
+        scenario(&with_localizer(&format!(
+            "[[robots.localization]]\ntype = \"{t}\""
+        )));
+    }
 }

@@ -179,6 +179,10 @@ fn hospital_patrol_robots_make_progress() {
     for seed in [0, 1] {
         let mut s = load_scenario(&bundled("hospital_patrol")).unwrap();
         s.seed = seed;
+        // localizers only write estimates, which nothing that moves the robots reads
+        for r in &mut s.robots {
+            r.localizers.clear();
+        }
         let out = run_scenario(
             &s,
             &RunOptions {

@@ -14,7 +14,7 @@
 //! each beam is scored with σ_b² = σ_hit² + cell²/12 + (range·Δθ)²/12, the variance of the
 //! endpoint over a cell (an approximation of integrating the likelihood over the cell).
 
-use super::layout::Layout;
+use super::layout::{Layout, Span};
 use crate::localization::mcl::LaserModelParams;
 use crate::world::DistanceField;
 use crate::world::distance_field::FAR;
@@ -60,18 +60,20 @@ impl PaddedField {
 
 /// Adds to `out` (one θ layer, `nx · ny`, row-major) the log-likelihood of the beams whose
 /// endpoints, rotated into this layer's heading, sit at field offsets `offsets` from a cell
-/// centre, beam b scored with `tables[b]`. Only free cells (the layout's spans) are touched.
+/// centre, beam b scored with `tables[b]`. Only the cells of `spans` (runs of free cells: the
+/// layout's, or the active part of them) are touched.
 pub fn layer_log_likelihood(
     field: &PaddedField,
     tables: &[[f32; 256]],
     layout: &Layout,
+    spans: &[Span],
     offsets: &[isize],
     out: &mut [f32],
 ) {
     let cells = &field.cells;
     let pad = field.pad as isize;
     let w = field.width as isize;
-    for s in &layout.spans {
+    for s in spans {
         let (i0, len, j) = (s.i0 as usize, s.len as usize, s.j as usize);
         let cols = &layout.fine_col[i0..i0 + len];
         let acc = &mut out[j * layout.nx + i0..j * layout.nx + i0 + len];
@@ -84,6 +86,24 @@ pub fn layer_log_likelihood(
             }
         }
     }
+}
+
+/// The log-likelihood of one cell (i, j) of a layer: [`layer_log_likelihood`] for a single cell.
+pub fn cell_log_likelihood(
+    field: &PaddedField,
+    tables: &[[f32; 256]],
+    layout: &Layout,
+    offsets: &[isize],
+    i: usize,
+    j: usize,
+) -> f32 {
+    let (pad, w) = (field.pad as isize, field.width as isize);
+    let centre = (layout.fine_row[j] as isize + pad) * w + pad + layout.fine_col[i] as isize;
+    offsets
+        .iter()
+        .zip(tables)
+        .map(|(&o, table)| table[field.cells[(centre + o) as usize] as usize])
+        .sum()
 }
 
 /// The log-likelihood table of a beam of length `range` (m): ln(z_hit·exp(−d²/2σ_b²) + z_rand/z_max)

@@ -29,7 +29,7 @@ use super::mcl::{InitialBelief, LaserModelParams, PoseEstimate};
 use super::motion_model::{OdometryMotionModel, moved_enough};
 use crate::core::{Pose2, wrap_angle};
 use correction::PaddedField;
-use layout::Layout;
+use layout::{Layout, Span};
 use rayon::prelude::*;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -48,6 +48,11 @@ pub struct MarkovGridConfig {
     pub update_min_d: f64,
     pub update_min_a: f64,
     pub init: InitialBelief,
+    /// Selective update (Fox, Burgard & Thrun, JAIR 11 (1999), §4.2): cells whose belief is
+    /// below this fraction of the most probable cell's are not scored; they are all weighted
+    /// with the scan's likelihood averaged over the floor (estimated on a fixed sample of
+    /// cells), which keeps the belief a density over all of the state space. 0 scores every cell.
+    pub selective_threshold: f64,
 }
 
 impl Default for MarkovGridConfig {
@@ -66,6 +71,7 @@ impl Default for MarkovGridConfig {
             update_min_d: 0.25,
             update_min_a: 10f64.to_radians(),
             init: InitialBelief::Global,
+            selective_threshold: 1e-6,
         }
     }
 }
@@ -79,9 +85,35 @@ pub struct MarkovGrid {
     scratch: Vec<f32>,
     tmp: Vec<f32>,
     field: Option<PaddedField>,
+    /// Per θ layer, the (i, j) cells whose mean likelihood stands for the floor's in the
+    /// selective update: every [`SAMPLE_STRIDE`]-th free cell.
+    sample: Vec<Vec<(u32, u32)>>,
     last_odom: Option<Pose2>,
     pub updates: u64,
     pub estimate: Option<PoseEstimate>,
+}
+
+/// Cells between two sample cells of the selective update (about 2 000 of the hospital's
+/// 2.7 million free cells × bins).
+const SAMPLE_STRIDE: usize = 1361;
+
+/// The selective update's sample: every `SAMPLE_STRIDE`-th cell in (layer, span) order.
+fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
+    let mut c = 0usize;
+    (0..l.n_theta)
+        .map(|_| {
+            let mut v = Vec::new();
+            for s in &l.spans {
+                for i in s.i0..s.i0 + s.len {
+                    if c.is_multiple_of(SAMPLE_STRIDE) {
+                        v.push((i, s.j));
+                    }
+                    c += 1;
+                }
+            }
+            v
+        })
+        .collect()
 }
 
 /// A cell centre `(x, y, heading offset, belief)` in the estimate's neighbourhood.
@@ -94,6 +126,7 @@ impl MarkovGrid {
             belief: vec![0.0; layout.len()],
             scratch: vec![0.0; layout.len()],
             tmp: Vec::new(),
+            sample: sample_cells(&layout),
             layout,
             config,
             field: None,
@@ -182,9 +215,16 @@ impl MarkovGrid {
         }
     }
 
-    /// Log-likelihood of the scan endpoints `points` (base frame) for every cell, into the
-    /// scratch buffer.
-    fn score(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+    /// Log-likelihood of the scan endpoints `points` (base frame) into the scratch buffer, for
+    /// every free cell or, given `active` (per layer), for those runs only; then also for the
+    /// sample cells, whose values are returned.
+    fn score(
+        &mut self,
+        map: &LocalizationMap,
+        points: &[[f32; 2]],
+        range_max: f32,
+        active: Option<&[Vec<Span>]>,
+    ) -> Vec<f32> {
         let reach = points
             .iter()
             .map(|p| (p[0] as f64).hypot(p[1] as f64))
@@ -209,11 +249,12 @@ impl MarkovGrid {
             .collect();
         let field = self.field.as_ref().expect("built above");
         let layout = &self.layout;
-        self.scratch
+        let sample = &self.sample;
+        let sampled: Vec<Vec<f32>> = self
+            .scratch
             .par_chunks_mut(layout.layer())
             .enumerate()
-            .for_each(|(k, out)| {
-                out.iter_mut().for_each(|v| *v = 0.0);
+            .map(|(k, out)| {
                 let (s, c) = layout.theta(k).sin_cos();
                 let offsets: Vec<isize> = points
                     .iter()
@@ -222,8 +263,60 @@ impl MarkovGrid {
                         field.offset(c * x - s * y, s * x + c * y)
                     })
                     .collect();
-                correction::layer_log_likelihood(field, &tables, layout, &offsets, out);
-            });
+                let spans = active.map_or(&layout.spans[..], |a| &a[k][..]);
+                for r in spans {
+                    let a = r.j as usize * layout.nx + r.i0 as usize;
+                    out[a..a + r.len as usize].iter_mut().for_each(|v| *v = 0.0);
+                }
+                correction::layer_log_likelihood(field, &tables, layout, spans, &offsets, out);
+                if active.is_none() {
+                    return Vec::new();
+                }
+                sample[k]
+                    .iter()
+                    .map(|&(i, j)| {
+                        correction::cell_log_likelihood(
+                            field, &tables, layout, &offsets, i as usize, j as usize,
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        sampled.concat()
+    }
+
+    /// The runs of cells at or above `threshold`, per layer, and their number.
+    fn active_runs(&self, threshold: f32) -> (Vec<Vec<Span>>, usize) {
+        let l = &self.layout;
+        let runs: Vec<Vec<Span>> = self
+            .belief
+            .par_chunks(l.layer())
+            .map(|b| {
+                let mut out = Vec::new();
+                for s in &l.spans {
+                    let row = s.j as usize * l.nx;
+                    let mut start: Option<u32> = None;
+                    for i in s.i0..=s.i0 + s.len {
+                        let on = i < s.i0 + s.len && b[row + i as usize] >= threshold;
+                        match (on, start) {
+                            (true, None) => start = Some(i),
+                            (false, Some(i0)) => {
+                                out.push(Span {
+                                    j: s.j,
+                                    i0,
+                                    len: i - i0,
+                                });
+                                start = None;
+                            }
+                            _ => {}
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        let n = runs.iter().flatten().map(|r| r.len as usize).sum();
+        (runs, n)
     }
 
     /// Correction by a scan's endpoints (base frame, max-range readings left out).
@@ -231,19 +324,59 @@ impl MarkovGrid {
         if points.is_empty() {
             return;
         }
-        self.score(map, points, range_max);
         let lambda = self.config.likelihood_exponent as f32;
-        let best = self
-            .belief
-            .iter()
-            .zip(&self.scratch)
-            .filter(|(p, _)| **p > 0.0)
-            .map(|(_, l)| *l)
-            .fold(f32::NEG_INFINITY, f32::max);
-        if best.is_finite() {
-            for (p, &l) in self.belief.iter_mut().zip(&self.scratch) {
-                if *p > 0.0 {
-                    *p *= (lambda * (l - best)).exp();
+        // selective update only when it skips at least half of the cells
+        let cells = self.layout.free_count() * self.layout.n_theta;
+        let peak = self.belief.iter().copied().fold(0.0f32, f32::max);
+        let threshold = (self.config.selective_threshold as f32 * peak).max(f32::MIN_POSITIVE);
+        let selective = (self.config.selective_threshold > 0.0)
+            .then(|| self.active_runs(threshold))
+            .filter(|(_, n)| 2 * n < cells);
+        let sampled = self.score(map, points, range_max, selective.as_ref().map(|a| &a.0[..]));
+        let l = &self.layout;
+        match selective {
+            None => {
+                let best = self
+                    .belief
+                    .iter()
+                    .zip(&self.scratch)
+                    .filter(|(p, _)| **p > 0.0)
+                    .map(|(_, l)| *l)
+                    .fold(f32::NEG_INFINITY, f32::max);
+                if best.is_finite() {
+                    for (p, &l) in self.belief.iter_mut().zip(&self.scratch) {
+                        if *p > 0.0 {
+                            *p *= (lambda * (l - best)).exp();
+                        }
+                    }
+                }
+            }
+            Some((runs, _)) => {
+                let layer = l.layer();
+                let best = runs
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(k, rs)| rs.iter().map(move |r| (k, r)))
+                    .flat_map(|(k, r)| {
+                        let a = k * layer + r.j as usize * l.nx + r.i0 as usize;
+                        self.scratch[a..a + r.len as usize].iter().copied()
+                    })
+                    .chain(sampled.iter().copied())
+                    .fold(f32::NEG_INFINITY, f32::max);
+                if best.is_finite() {
+                    let floor = sampled
+                        .iter()
+                        .map(|&v| (lambda * (v - best)).exp() as f64)
+                        .sum::<f64>()
+                        / sampled.len().max(1) as f64;
+                    let floor = floor as f32;
+                    for (p, &l) in self.belief.iter_mut().zip(&self.scratch) {
+                        if *p >= threshold {
+                            *p *= (lambda * (l - best)).exp();
+                        } else if *p > 0.0 {
+                            *p *= floor;
+                        }
+                    }
                 }
             }
         }

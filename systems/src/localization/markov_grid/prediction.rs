@@ -34,29 +34,37 @@ pub fn shift(layout: &Layout, d: &OdometryDelta, src: &[f32], dst: &mut [f32]) {
         let k0 = (k as isize + dk0 as isize).rem_euclid(nt as isize) as usize;
         let k1 = (k0 + 1) % nt;
         let from = &src[k * layer..(k + 1) * layer];
+        // the whole layer moves by the same (ix + ox, iy + oy): contiguous row slices; mass
+        // that lands on a cell outside free space is dropped below
         for s in &layout.spans {
             let j = s.j as isize;
-            for i in s.i0 as isize..(s.i0 + s.len) as isize {
-                let m = from[(j * nx + i) as usize];
-                if m == 0.0 {
+            for &(ox, oy, w) in &weights {
+                let tj = j + iy + oy;
+                if w == 0.0 || tj < 0 || tj >= ny {
                     continue;
                 }
-                for &(ox, oy, w) in &weights {
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let (ti, tj) = (i + ix + ox, j + iy + oy);
-                    if ti < 0 || tj < 0 || ti >= nx || tj >= ny {
-                        continue;
-                    }
-                    let c = (tj * nx + ti) as usize;
-                    if !layout.free[c] {
-                        continue;
-                    }
-                    let v = m * w;
-                    dst[k0 * layer + c] += v * (1.0 - wk);
-                    dst[k1 * layer + c] += v * wk;
+                let (i0, i1) = (s.i0 as isize, (s.i0 + s.len) as isize);
+                let dx = ix + ox;
+                let (a, b) = ((i0 + dx).max(0), (i1 + dx).min(nx));
+                if a >= b {
+                    continue;
                 }
+                let src_row = &from[(j * nx + a - dx) as usize..(j * nx + b - dx) as usize];
+                let t = (tj * nx + a) as usize..(tj * nx + b) as usize;
+                let (w0, w1) = (w * (1.0 - wk), w * wk);
+                for (d, &m) in dst[k0 * layer..][t.clone()].iter_mut().zip(src_row) {
+                    *d += m * w0;
+                }
+                for (d, &m) in dst[k1 * layer..][t].iter_mut().zip(src_row) {
+                    *d += m * w1;
+                }
+            }
+        }
+    }
+    for layer_cells in dst.chunks_mut(layer) {
+        for (v, &f) in layer_cells.iter_mut().zip(&layout.free) {
+            if !f {
+                *v = 0.0;
             }
         }
     }

@@ -24,7 +24,7 @@ fn layer_score_matches_a_direct_evaluation() {
     let truth = Pose2::new(10.0, 16.0, 0.3);
     let scan = scan_at(&map, &truth, &mut rng);
     let pts = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60).returns();
-    grid.score(&map, &pts, 20.0);
+    grid.score(&map, &pts, 20.0, None);
     let l = &grid.layout;
     let (i, j, k) = l.cell_of(truth.x, truth.y, truth.theta).unwrap();
     let (x, y) = l.centre(i, j);

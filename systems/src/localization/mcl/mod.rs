@@ -15,6 +15,7 @@
 //! - estimate: weighted mean and covariance of the dominant cluster ([`cluster`]).
 
 pub mod cluster;
+pub mod injection;
 pub mod resample;
 pub mod sensor_model;
 
@@ -64,6 +65,15 @@ pub struct MclConfig {
     /// Augmented MCL averages (0 disables injection).
     pub recovery_alpha_slow: f64,
     pub recovery_alpha_fast: f64,
+    /// Injection starts once w_fast / w_slow falls below this ratio: the probability is
+    /// max(0, 1 − (w_fast / w_slow) / ratio). 1 is Table 8.3's rule, which also injects on the
+    /// ordinary ups and downs of the scan fit while tracking; below 1 only a real drop counts.
+    pub recovery_ratio: f64,
+    /// Where injected particles come from: 0 draws them uniformly over free space (AMCL);
+    /// n > 0 draws them from poses that explain the current scan, found by a search with n
+    /// candidates per round ([`injection`]), so a kidnapped robot is found in a large building
+    /// within seconds.
+    pub injection_candidates: usize,
     pub init: InitialBelief,
     pub bins: BinSize,
 }
@@ -84,6 +94,8 @@ impl Default for MclConfig {
             motion: OdometryMotionModel::default(),
             recovery_alpha_slow: 0.001,
             recovery_alpha_fast: 0.1,
+            recovery_ratio: 0.7,
+            injection_candidates: 20_000,
             init: InitialBelief::Global,
             bins: BinSize::default(),
         }
@@ -105,6 +117,8 @@ pub struct Mcl {
     rng: SimRng,
     w_slow: f64,
     w_fast: f64,
+    /// Updates that fed w_slow and w_fast.
+    averaged: u64,
     last_odom: Option<Pose2>,
     table: Option<[f32; 256]>,
     /// Updates done (a scan consumed after enough motion).
@@ -147,6 +161,7 @@ impl Mcl {
             rng,
             w_slow: 0.0,
             w_fast: 0.0,
+            averaged: 0,
             last_odom: None,
             table: None,
             updates: 0,
@@ -187,18 +202,19 @@ impl Mcl {
             });
     }
 
+    /// The likelihood-field table of the configured laser model for scans of `range_max`.
+    fn field_table(&mut self, map: &LocalizationMap, range_max: f32) -> [f32; 256] {
+        *self.table.get_or_insert_with(|| {
+            sensor_model::likelihood_table(&map.field, &self.config.laser, range_max as f64)
+        })
+    }
+
     /// Multiplies the weights by the scan's likelihood; returns the mean likelihood factor.
     pub fn weigh(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> f64 {
         let old_total: f64 = self.w.iter().sum();
         match self.config.model {
             LaserModel::LikelihoodField => {
-                let table = *self.table.get_or_insert_with(|| {
-                    sensor_model::likelihood_table(
-                        &map.field,
-                        &self.config.laser,
-                        beams.range_max as f64,
-                    )
-                });
+                let table = self.field_table(map, beams.range_max);
                 let points = beams.returns();
                 sensor_model::weigh_likelihood_field(
                     &map.field,
@@ -253,32 +269,69 @@ impl Mcl {
         // Augmented MCL: the likelihood is normalised per beam count so α's mean the same for
         // every laser
         let avg = mean_p.max(f64::MIN_POSITIVE);
-        if self.w_slow == 0.0 {
-            self.w_slow = avg;
-            self.w_fast = avg;
-        } else {
-            self.w_slow += self.config.recovery_alpha_slow * (avg - self.w_slow);
-            self.w_fast += self.config.recovery_alpha_fast * (avg - self.w_fast);
-        }
+        // Both averages start as the plain mean of the updates so far (an exponential average
+        // that starts at the first value stays for ~1/α updates near it: a first update of a
+        // spread-out filter fits poorly, and w_slow would then sit too low to ever trigger).
+        self.averaged += 1;
+        let early = 1.0 / self.averaged as f64;
+        let (a_slow, a_fast) = (
+            self.config.recovery_alpha_slow.max(early),
+            self.config.recovery_alpha_fast.max(early),
+        );
+        self.w_slow += a_slow * (avg - self.w_slow);
+        self.w_fast += a_fast * (avg - self.w_fast);
         let p_inject = if self.config.recovery_alpha_slow > 0.0 {
-            (1.0 - self.w_fast / self.w_slow).max(0.0)
+            let ratio = self.w_fast / self.w_slow;
+            (1.0 - ratio / self.config.recovery_ratio).max(0.0)
         } else {
             0.0
         };
         let n_eff = 1.0 / self.w.iter().map(|w| w * w).sum::<f64>();
+
         if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
             // Unlike AMCL, the averages are not reset after an injection (Table 8.3 has no
             // reset): AMCL's reset ends the injection after one burst of a few percent, which
             // rarely finds a kidnapped robot; here random particles keep coming while the
             // scans fit worse than they used to.
-            self.resample(map, p_inject);
+            let pool = self.injection_pool(map, beams, p_inject);
+            self.resample(map, p_inject, pool.as_ref());
         }
         self.updates += 1;
         self.estimate = self.cluster();
         true
     }
 
-    fn resample(&mut self, map: &LocalizationMap, p_inject: f64) {
+    /// The poses injected particles are drawn from (see [`MclConfig::injection_candidates`]);
+    /// None when nothing is injected or the proposal is off.
+    fn injection_pool(
+        &mut self,
+        map: &LocalizationMap,
+        beams: &BeamSubset,
+        p_inject: f64,
+    ) -> Option<Vec<(f64, f64, f64)>> {
+        let n = self.config.injection_candidates;
+        if p_inject <= 0.0 || n == 0 || beams.is_empty() {
+            return None;
+        }
+        let table = self.field_table(map, beams.range_max);
+        let pool = injection::scan_proposal(
+            map,
+            &self.config.laser,
+            &table,
+            &beams.returns(),
+            beams.range_max,
+            n,
+            &mut self.rng,
+        );
+        (!pool.is_empty()).then_some(pool)
+    }
+
+    fn resample(
+        &mut self,
+        map: &LocalizationMap,
+        p_inject: f64,
+        pool: Option<&Vec<(f64, f64, f64)>>,
+    ) {
         let limits = CountLimits {
             min: self.config.min_particles,
             max: self.config.max_particles,
@@ -295,7 +348,10 @@ impl Mcl {
             &self.config.bins,
             p_inject,
             &mut self.rng,
-            |u| map.random_free_pose(u),
+            |u| match pool {
+                Some(p) => p[((u() * p.len() as f64) as usize).min(p.len() - 1)],
+                None => map.random_free_pose(u),
+            },
         );
         self.resamplings += 1;
     }

@@ -1,0 +1,118 @@
+//! Where injected particles come from: a proposal drawn from the current scan instead of the
+//! whole floor. Augmented MCL (Probabilistic Robotics Table 8.3) injects uniform random poses;
+//! in a floor of thousands of square metres almost none lands near a kidnapped robot. Mixture
+//! MCL (Thrun, Fox, Burgard & Dellaert, "Robust Monte Carlo localization for mobile robots",
+//! Artificial Intelligence 128 (2001), §4, the dual proposal x ~ p(z | x)) and sensor
+//! resetting (Lenser & Veloso, ICRA 2000) draw them from poses that explain the scan instead.
+//!
+//! p(z | x) cannot be sampled directly on a map, so it is approximated by a short search:
+//! `n` uniform free poses are scored on a widened likelihood field (σ ≥ [`WIDE_SIGMA`], so poses
+//! a metre off still rank well); the best [`KEEP`] — at most [`PER_BIN`] per 1 m × 1 m × 30°
+//! bin, so several look-alike places survive — each spawn `n / KEEP` jittered copies, scored
+//! again, for [`ROUNDS`] rounds of halving jitter, the last on the filter's own likelihood
+//! field. The [`KEEP`] survivors are the proposal; the filter's weighting decides between them.
+
+use super::LaserModelParams;
+use super::sensor_model::{likelihood_table, weigh_likelihood_field};
+use crate::core::{SimRng, wrap_angle};
+use crate::localization::map::LocalizationMap;
+use rand::RngExt;
+use rand_distr::{Distribution, StandardNormal};
+use std::collections::HashMap;
+
+/// The smallest σ_hit (m) of the first rounds' likelihood field.
+pub const WIDE_SIGMA: f64 = 0.5;
+/// Candidates kept per round.
+pub const KEEP: usize = 64;
+/// At most this many kept candidates per 1 m × 1 m × 30° bin.
+pub const PER_BIN: usize = 4;
+/// Refinement rounds after the uniform draw.
+pub const ROUNDS: usize = 3;
+/// Jitter of the first refinement round (m, m, rad); halved every round.
+const JITTER: [f64; 3] = [0.4, 0.4, 0.15];
+
+/// Up to [`KEEP`] poses (x, y, θ) that explain the scan endpoints `points` (base frame); `n`
+/// candidates per round.
+pub fn scan_proposal(
+    map: &LocalizationMap,
+    laser: &LaserModelParams,
+    table: &[f32; 256],
+    points: &[[f32; 2]],
+    range_max: f32,
+    n: usize,
+    rng: &mut SimRng,
+) -> Vec<(f64, f64, f64)> {
+    if points.is_empty() || n == 0 {
+        return Vec::new();
+    }
+    let wide_params = LaserModelParams {
+        sigma_hit: laser.sigma_hit.max(WIDE_SIGMA),
+        ..*laser
+    };
+    let wide = likelihood_table(&map.field, &wide_params, range_max as f64);
+    let mut cand: Vec<[f64; 3]> = (0..n)
+        .map(|_| {
+            let (x, y, t) = map.random_free_pose(&mut || rng.random::<f64>());
+            [x, y, t]
+        })
+        .collect();
+    let mut kept = best_distinct(map, &wide, points, &cand);
+    let per = n.div_ceil(kept.len().max(1));
+    for round in 0..ROUNDS {
+        let sd = JITTER.map(|v| v / f64::from(1u32 << round));
+        cand.clear();
+        for k in &kept {
+            cand.push(*k);
+            for _ in 1..per {
+                let mut g = || -> f64 { StandardNormal.sample(&mut *rng) };
+                cand.push([
+                    k[0] + sd[0] * g(),
+                    k[1] + sd[1] * g(),
+                    wrap_angle(k[2] + sd[2] * g()),
+                ]);
+            }
+        }
+        let t = if round + 1 == ROUNDS { table } else { &wide };
+        kept = best_distinct(map, t, points, &cand);
+    }
+    kept.into_iter().map(|p| (p[0], p[1], p[2])).collect()
+}
+
+/// The best-scoring [`KEEP`] candidates on free cells, at most [`PER_BIN`] per bin.
+fn best_distinct(
+    map: &LocalizationMap,
+    table: &[f32; 256],
+    points: &[[f32; 2]],
+    cand: &[[f64; 3]],
+) -> Vec<[f64; 3]> {
+    let xs: Vec<f64> = cand.iter().map(|c| c[0]).collect();
+    let ys: Vec<f64> = cand.iter().map(|c| c[1]).collect();
+    let ths: Vec<f64> = cand.iter().map(|c| c[2]).collect();
+    let mut score = vec![1.0; cand.len()];
+    weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+    let mut order: Vec<usize> = (0..cand.len()).collect();
+    order.sort_by(|&a, &b| score[b].total_cmp(&score[a]).then(a.cmp(&b)));
+    let mut per_bin: HashMap<(i64, i64, i64), usize> = HashMap::new();
+    let mut kept = Vec::with_capacity(KEEP);
+    for i in order {
+        let c = cand[i];
+        if !map.is_free(c[0], c[1]) {
+            continue;
+        }
+        let bin = (
+            c[0].floor() as i64,
+            c[1].floor() as i64,
+            (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
+        );
+        let count = per_bin.entry(bin).or_insert(0);
+        if *count >= PER_BIN {
+            continue;
+        }
+        *count += 1;
+        kept.push(c);
+        if kept.len() == KEEP {
+            break;
+        }
+    }
+    kept
+}
