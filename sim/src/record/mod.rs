@@ -1,6 +1,7 @@
 //! Recording: the Rerun .rrd file (always, unless disabled) and, on request, TUM trajectories of
 //! every localizer. MCAP replays come later.
 
+pub mod belief;
 pub mod rrd;
 pub mod tum;
 

@@ -4,17 +4,33 @@
 //! - `robots/<name>/truth`: ground-truth pose (arrow) and driven path (line strip);
 //! - `robots/<name>/body`: the footprint outline;
 //! - `robots/<name>/odometry`: wheel-odometry pose and path;
-//! - `robots/<name>/scan`: the latest scan's endpoints in the world frame.
+//! - `robots/<name>/scan`: the latest scan's endpoints in the world frame;
+//! - `robots/<name>/estimate/<localizer>`: each localizer's pose (arrow, at every estimate it
+//!   publishes) and its estimate path (line strip, at the path rate, like the odometry's);
+//!   `…/estimate/<localizer>/covariance`: the 2-σ ellipse of the (x, y) covariance and the ±2σ
+//!   heading wedge;
+//! - `robots/<name>/particles/<localizer>`: MCL particles, DE populations and the Markov grid's
+//!   belief cells (see [`super::belief`] for colours and subsampling). A set is logged only
+//!   after a filter update and at most `particle_rate` times per second (default 2: every
+//!   0.5 s of simulated time, or at every update when the filter updates more rarely), with at
+//!   most `particle_points` points (default 1000; 0 turns particles off), so a 100 000-particle
+//!   filter costs the same ~16 kB per set as a small one;
+//! - `robots/<name>/error/<localizer>`: position error (m) of every published estimate against
+//!   ground truth at its timestamp (the pairs the summary's metrics use), as a scalar series;
+//!   `…/error/<localizer>/heading`: the absolute heading error (rad). The recorder reads ground
+//!   truth; the localizers never do.
 //!
 //! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
 
+use super::belief::{self, Cloud};
 use crate::scenario::RecordConfig;
 use bevy_ecs::prelude::*;
 use std::path::Path;
 use systems::body::{Footprint, TruePose};
 use systems::core::clock::RateTimer;
-use systems::core::{Pose2, RobotId, RobotIndex, SimClock};
-use systems::localization::WheelOdometry;
+use systems::core::{Pose2, RobotId, RobotIndex, SimClock, wrap_angle};
+use systems::eval::LocalizationSamples;
+use systems::localization::{Localizer, Localizers, PoseEstimate, WheelOdometry};
 use systems::sensors::{LaserScans, LaserTruth};
 use systems::world::{Cell, OccupancyGrid};
 
@@ -29,9 +45,23 @@ pub struct RrdRecorder {
     path_timer: RateTimer,
     truth_paths: Vec<Vec<[f32; 3]>>,
     odom_paths: Vec<Vec<[f32; 3]>>,
+    /// Per robot (by index), per localizer (in the robot's order).
+    tracks: Vec<Vec<Track>>,
+    particle_period: f64,
+    particle_points: usize,
     /// The first logging error, reported when the run ends.
     pub error: Option<String>,
     due: Vec<f64>,
+}
+
+/// What the recorder keeps per localizer.
+#[derive(Default)]
+struct Track {
+    path: Vec<[f32; 3]>,
+    /// Simulated time of the last logged particle set.
+    particles_at: Option<f64>,
+    /// Whether the series styles were logged.
+    styled: bool,
 }
 
 fn colour(index: u32) -> rerun::Color {
@@ -77,6 +107,9 @@ impl RrdRecorder {
             path_timer: RateTimer::new(config.path_rate, 0.0),
             truth_paths: Vec::new(),
             odom_paths: Vec::new(),
+            tracks: Vec::new(),
+            particle_period: 1.0 / config.particle_rate,
+            particle_points: config.particle_points,
             error: None,
             due: Vec::new(),
         };
@@ -139,7 +172,132 @@ fn arrow(p: &Pose2, len: f32, c: rerun::Color) -> rerun::Arrows3D {
         .with_colors([c])
 }
 
-/// Record: log poses, paths and scans when their timers are due.
+fn cloud(c: &Cloud) -> rerun::Points3D {
+    rerun::Points3D::new(c.points.iter().copied())
+        .with_colors(
+            c.colors
+                .iter()
+                .map(|k| rerun::Color::from_rgb(k[0], k[1], k[2])),
+        )
+        .with_radii([c.radius])
+}
+
+/// Colour of a robot's `k`-th localizer (its estimate arrow, path and covariance).
+fn localizer_colour(k: usize) -> rerun::Color {
+    colour(k as u32 + 1)
+}
+
+impl RrdRecorder {
+    /// Logs what a localizer published this tick: estimate, covariance, error series and (when
+    /// due) its particle set; the estimate path when `paths_due`.
+    fn record_localizer(
+        &mut self,
+        base: &str,
+        robot: usize,
+        k: usize,
+        l: &Localizer,
+        samples: &[systems::eval::Sample],
+        now: f64,
+        paths_due: bool,
+    ) {
+        if self.tracks.len() <= robot {
+            self.tracks.resize_with(robot + 1, Vec::new);
+        }
+        if self.tracks[robot].len() <= k {
+            self.tracks[robot].resize_with(k + 1, Track::default);
+        }
+        let name = &l.name;
+        let c = localizer_colour(k);
+        let est_path = format!("{base}/estimate/{name}");
+        let err_path = format!("{base}/error/{name}");
+        if !self.tracks[robot][k].styled {
+            self.tracks[robot][k].styled = true;
+            let res = self.rec.log_static(
+                err_path.as_str(),
+                &rerun::SeriesLines::new()
+                    .with_names([format!("{name} position error (m)")])
+                    .with_colors([c]),
+            );
+            self.check(res);
+            let res = self.rec.log_static(
+                format!("{err_path}/heading"),
+                &rerun::SeriesLines::new()
+                    .with_names([format!("{name} heading error (rad)")])
+                    .with_colors([c]),
+            );
+            self.check(res);
+        }
+        // the eval system paired this tick's estimates with ground truth: they are the tail
+        let fresh = l.fresh.len();
+        let paired = samples.len() >= fresh
+            && l.fresh.last().map(|e| e.stamp) == samples.last().map(|s| s.t);
+        if paired {
+            for s in &samples[samples.len() - fresh..] {
+                self.rec.set_duration_secs("sim_time", s.t);
+                let res = self
+                    .rec
+                    .log(err_path.as_str(), &rerun::Scalars::single(s.position_error()));
+                self.check(res);
+                let dth = wrap_angle(s.estimate.theta - s.truth.theta).abs();
+                let res = self
+                    .rec
+                    .log(format!("{err_path}/heading"), &rerun::Scalars::single(dth));
+                self.check(res);
+            }
+        }
+        for e in &l.fresh {
+            push_point(&mut self.tracks[robot][k].path, &e.estimate.pose);
+        }
+        if let Some(e) = l.fresh.last() {
+            self.rec.set_duration_secs("sim_time", e.stamp);
+            self.log_estimate(&est_path, &e.estimate, c);
+            let track = &self.tracks[robot][k];
+            let particles_due = self.particle_points > 0
+                && track
+                    .particles_at
+                    .is_none_or(|t| e.stamp - t >= self.particle_period - 1e-9);
+            if particles_due
+                && let Some(set) = belief::filter_cloud(&l.filter, self.particle_points)
+            {
+                self.tracks[robot][k].particles_at = Some(e.stamp);
+                let res = self
+                    .rec
+                    .log(format!("{base}/particles/{name}"), &cloud(&set));
+                self.check(res);
+            }
+        }
+        self.rec.set_duration_secs("sim_time", now);
+        if paths_due && !self.tracks[robot][k].path.is_empty() {
+            let strip =
+                rerun::LineStrips3D::new([self.tracks[robot][k].path.clone()]).with_colors([c]);
+            let res = self.rec.log(est_path.as_str(), &strip);
+            self.check(res);
+        }
+    }
+
+    fn log_estimate(&mut self, path: &str, e: &PoseEstimate, c: rerun::Color) {
+        let res = self.rec.log(path, &arrow(&e.pose, 0.45, c));
+        self.check(res);
+        let p = &e.pose;
+        let strips: Vec<Vec<[f32; 3]>> = [
+            belief::ellipse_2sigma(p.x, p.y, &e.covariance, 36),
+            belief::heading_wedge(p.x, p.y, p.theta, e.covariance[2][2], 0.6),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if !strips.is_empty() {
+            let res = self.rec.log(
+                format!("{path}/covariance"),
+                &rerun::LineStrips3D::new(strips).with_colors([c]),
+            );
+            self.check(res);
+        }
+    }
+}
+
+/// Record: log poses, paths and scans when their timers are due, and what the localizers
+/// published this tick.
 #[allow(clippy::type_complexity)]
 pub fn record_rrd(
     clock: Res<SimClock>,
@@ -151,6 +309,7 @@ pub fn record_rrd(
         &Footprint,
         Option<&WheelOdometry>,
         Option<(&LaserScans, &LaserTruth)>,
+        Option<(&Localizers, &LocalizationSamples)>,
     )>,
 ) {
     let r = &mut *r;
@@ -163,24 +322,40 @@ pub fn record_rrd(
     r.path_timer.due(start, now, &mut due);
     let paths_due = !due.is_empty();
     r.due = due;
-    if !(poses_due || scans_due || paths_due) {
+    let published = robots
+        .iter()
+        .any(|q| q.6.is_some_and(|(l, _)| l.items.iter().any(|l| !l.fresh.is_empty())));
+    if !(poses_due || scans_due || paths_due || published) {
         return;
     }
     r.rec.set_duration_secs("sim_time", now);
     let mut sorted: Vec<_> = robots.iter().collect();
     sorted.sort_by_key(|(i, ..)| **i);
-    for (idx, id, truth, footprint, odom, laser) in sorted {
+    for (idx, id, truth, footprint, odom, laser, locs) in sorted {
         let i = idx.0 as usize;
         if r.truth_paths.len() <= i {
             r.truth_paths.resize_with(i + 1, Vec::new);
             r.odom_paths.resize_with(i + 1, Vec::new);
+        }
+        let base = format!("robots/{}", id.0);
+        if let Some((locs, samples)) = locs {
+            for (k, l) in locs.items.iter().enumerate() {
+                let s = samples
+                    .per_localizer
+                    .get(k)
+                    .filter(|(n, _)| *n == l.name)
+                    .map_or(&[][..], |(_, s)| &s[..]);
+                r.record_localizer(&base, i, k, l, s, now, paths_due);
+            }
+        }
+        if !(poses_due || scans_due || paths_due) {
+            continue;
         }
         push_point(&mut r.truth_paths[i], &truth.pose);
         if let Some(o) = odom {
             push_point(&mut r.odom_paths[i], &o.pose);
         }
         let c = colour(idx.0);
-        let base = format!("robots/{}", id.0);
         if poses_due {
             let res = r
                 .rec

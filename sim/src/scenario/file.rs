@@ -68,6 +68,10 @@ pub struct RecordFile {
     pub scan_rate: Option<f64>,
     /// Driven paths per second.
     pub path_rate: Option<f64>,
+    /// Localizer particle sets (MCL particles, DE populations, Markov grid cells) per second.
+    pub particle_rate: Option<f64>,
+    /// At most this many points per logged particle set.
+    pub particle_points: Option<usize>,
 }
 
 #[derive(Deserialize, Debug)]

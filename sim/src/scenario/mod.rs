@@ -45,6 +45,10 @@ pub struct RecordConfig {
     pub scan_rate: f64,
     /// Driven paths per second.
     pub path_rate: f64,
+    /// Localizer particle sets per second (and at most one per filter update).
+    pub particle_rate: f64,
+    /// At most this many points per logged particle set (subsampled).
+    pub particle_points: usize,
 }
 
 impl Default for RecordConfig {
@@ -53,6 +57,8 @@ impl Default for RecordConfig {
             rate: 10.0,
             scan_rate: 5.0,
             path_rate: 1.0,
+            particle_rate: 2.0,
+            particle_points: 1000,
         }
     }
 }

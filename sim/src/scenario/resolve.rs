@@ -254,6 +254,12 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         rate: c.opt_positive(&rp.key("rate"), rec.rate, d.rate)?,
         scan_rate: c.opt_positive(&rp.key("scan_rate"), rec.scan_rate, d.scan_rate)?,
         path_rate: c.opt_positive(&rp.key("path_rate"), rec.path_rate, d.path_rate)?,
+        particle_rate: c.opt_positive(
+            &rp.key("particle_rate"),
+            rec.particle_rate,
+            d.particle_rate,
+        )?,
+        particle_points: rec.particle_points.unwrap_or(d.particle_points),
     };
 
     // --- robots
