@@ -1,4 +1,6 @@
-"""Prints the entity paths and timelines of an .rrd as JSON, read with the Rerun SDK (0.36.3)."""
+"""Prints the entity paths and timelines of an .rrd as JSON, read with the Rerun SDK (0.36.3),
+and, per entity holding `Scalars`, the number of values, their minimum, maximum and median, and
+the first and last `sim_time` (seconds) they were logged at."""
 
 import json
 import sys
@@ -11,7 +13,32 @@ def main() -> None:
     schema = store.schema()
     paths = sorted(str(p) for p in schema.entity_paths())
     timelines = sorted({c.name for c in schema.index_columns()})
-    print(json.dumps({"entity_paths": paths, "timelines": timelines}))
+    values: dict[str, list[float]] = {}
+    times: dict[str, list[float]] = {}
+    for chunk in store.stream():
+        batch = chunk.to_record_batch()
+        names = batch.schema.names
+        if "Scalars:scalars" not in names or "sim_time" not in names:
+            continue
+        scalars = batch.column(names.index("Scalars:scalars")).to_pylist()
+        stamps = batch.column(names.index("sim_time")).cast("int64").to_pylist()
+        path = chunk.entity_path
+        for row, t in zip(scalars, stamps):
+            for v in row or []:
+                values.setdefault(path, []).append(float(v))
+                times.setdefault(path, []).append(t * 1e-9)
+    scalars_out = {}
+    for path, vs in values.items():
+        s = sorted(vs)
+        scalars_out[path] = {
+            "count": len(vs),
+            "min": s[0],
+            "max": s[-1],
+            "median": s[len(s) // 2],
+            "first_t": min(times[path]),
+            "last_t": max(times[path]),
+        }
+    print(json.dumps({"entity_paths": paths, "timelines": timelines, "scalars": scalars_out}))
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 //! and the `sim` command line.
 
 pub mod bench;
+pub mod bench_loc;
 pub mod bench_match;
 pub mod build;
 pub mod experiment;

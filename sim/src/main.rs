@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use sim::bench::{SwarmOptions, run_swarm_bench};
+use sim::bench_loc::{LocBenchOptions, run_markov_grid_bench, run_mcl_bench};
 use sim::bench_match::{DeMatchBenchOptions, run_de_match_bench};
 use sim::experiment::de_match::{DeMatchOptions, run_de_match_experiment};
 use sim::match_cmd::{CrossoverArg, FitnessArg, MatchOptions, parse_strategy, run_match};
@@ -173,6 +174,34 @@ enum BenchCommand {
         /// Number of hospital scan pairs timed.
         #[arg(long, default_value_t = 100)]
         pairs: usize,
+    },
+    /// MCL update time (likelihood field, KLD off) on the hospital map, one core.
+    Mcl {
+        /// One JSON object per particle count, one per line.
+        #[arg(long)]
+        json: bool,
+        /// Timed updates per configuration (the median is reported; 1 for a quick check).
+        #[arg(long, default_value_t = 50)]
+        reps: usize,
+        /// Particle counts.
+        #[arg(long, value_delimiter = ',', default_values_t = [1000usize, 5000, 20000])]
+        particles: Vec<usize>,
+        /// Beams used per scan.
+        #[arg(long, default_value_t = 60)]
+        beams: usize,
+    },
+    /// Markov grid update time (0.25 m × 10°) on the hospital map, global and selective, one
+    /// core.
+    MarkovGrid {
+        /// One JSON object per mode, one per line.
+        #[arg(long)]
+        json: bool,
+        /// Timed updates per mode (the median is reported; 1 for a quick check).
+        #[arg(long, default_value_t = 10)]
+        reps: usize,
+        /// Beams used per scan.
+        #[arg(long, default_value_t = 60)]
+        beams: usize,
     },
 }
 
@@ -454,6 +483,25 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
                 duration,
                 threads,
             }),
+            BenchCommand::Mcl {
+                json,
+                reps,
+                particles,
+                beams,
+            } => run_mcl_bench(&LocBenchOptions {
+                json,
+                reps,
+                particles,
+                beams,
+            }),
+            BenchCommand::MarkovGrid { json, reps, beams } => {
+                run_markov_grid_bench(&LocBenchOptions {
+                    json,
+                    reps,
+                    particles: Vec::new(),
+                    beams,
+                })
+            }
             BenchCommand::DeMatch { json, pairs } => {
                 run_de_match_bench(&DeMatchBenchOptions { json, pairs })
             }

@@ -96,8 +96,17 @@ impl RrdRecorder {
         grid: &OccupancyGrid,
         config: &RecordConfig,
     ) -> anyhow::Result<Self> {
+        // Chunks are cut by size, not by wall time (the default flushes every 200 ms of wall
+        // time, which gives a fast run thousands of tiny chunks of mostly metadata): a quarter
+        // of the file size for a run with localizers, and the same chunks whatever the speed.
+        let batcher = rerun::log::ChunkBatcherConfig {
+            flush_tick: std::time::Duration::from_secs(3600),
+            flush_num_bytes: 1024 * 1024,
+            ..rerun::log::ChunkBatcherConfig::DEFAULT
+        };
         let rec = rerun::RecordingStreamBuilder::new("sim")
             .recording_name(scenario_name)
+            .batcher_config(batcher)
             .save(path)
             .map_err(|e| anyhow::anyhow!("{}: cannot create the recording: {e}", path.display()))?;
         let mut r = RrdRecorder {

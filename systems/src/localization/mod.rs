@@ -7,6 +7,7 @@ pub mod de_mc;
 pub mod de_odometry;
 pub mod de_population;
 pub mod de_tracker;
+pub mod fixtures;
 pub mod localizer;
 pub mod map;
 pub mod markov_grid;

@@ -1,7 +1,8 @@
 //! The written .rrd opens with the Rerun 0.36.3 tools and holds the entity paths of DESIGN.md on
-//! the `sim_time` timeline.
+//! the `sim_time` timeline, including every localizer's estimate, particle set and error series.
 
 use crate::common::*;
+use sim::scenario::LocalizerKind;
 use sim::scenario::load_scenario;
 use sim::{RunOptions, run_scenario};
 use std::process::Command;
@@ -69,8 +70,49 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
             want.push(format!("/robots/{}/{leaf}", r.name));
         }
     }
+    let mut localizers = 0;
+    for r in &s.robots {
+        for l in &r.localizers {
+            localizers += 1;
+            let base = format!("/robots/{}", r.name);
+            want.push(format!("{base}/estimate/{}", l.name));
+            want.push(format!("{base}/estimate/{}/covariance", l.name));
+            want.push(format!("{base}/error/{}", l.name));
+            want.push(format!("{base}/error/{}/heading", l.name));
+            // DE odometry keeps no population
+            if !matches!(l.kind, LocalizerKind::DeOdometry(_)) {
+                want.push(format!("{base}/particles/{}", l.name));
+            }
+        }
+    }
+    assert!(localizers >= 4, "the scenario should carry localizers");
     for w in &want {
         assert!(paths.contains(&w.as_str()), "missing {w} in {paths:?}");
+    }
+    // the error series: one value per published estimate, plausible for every localizer, and
+    // small for MCL tracking from the known start pose
+    let scalars = &v["scalars"];
+    for r in &s.robots {
+        for l in &r.localizers {
+            let pos = &scalars[format!("/robots/{}/error/{}", r.name, l.name)];
+            let head = &scalars[format!("/robots/{}/error/{}/heading", r.name, l.name)];
+            let f = |x: &serde_json::Value, k: &str| x[k].as_f64().unwrap_or(f64::NAN);
+            assert!(f(pos, "count") >= 3.0, "{} {}: {pos}", r.name, l.name);
+            assert_eq!(pos["count"], head["count"], "{} {}", r.name, l.name);
+            assert!(f(pos, "min") >= 0.0 && f(pos, "max") < 100.0, "{pos}");
+            assert!(
+                f(head, "min") >= 0.0 && f(head, "max") <= std::f64::consts::PI + 1e-9,
+                "{head}"
+            );
+            assert!(f(pos, "first_t") >= 0.0 && f(pos, "last_t") <= s.duration + 1e-6);
+            if l.name == "mcl" {
+                assert!(
+                    f(pos, "max") < 0.5 && f(head, "max") < 0.2,
+                    "{}: mcl from the start pose should track: {pos} {head}",
+                    r.name
+                );
+            }
+        }
     }
     let timelines = v["timelines"].as_array().unwrap();
     assert!(timelines.iter().any(|t| t == "sim_time"), "{timelines:?}");

@@ -1,0 +1,158 @@
+//! Localizer updates on the hospital map, on one core (a 1-thread rayon pool), with the scans and
+//! odometry of a drive along the hospital's corridors ([`fixtures::recorded_drive`]):
+//!
+//! - `mcl_update/<n>`: a full MCL update (motion sampling, likelihood-field weighing of 60
+//!   beams, resampling when due, clustering) with n = 1 000, 5 000, 20 000 particles, KLD off;
+//! - `mcl_weigh/<n>`: the likelihood-field kernel alone on the same particle sets;
+//! - `markov_grid_update/selective`: a Markov grid update (0.25 m × 10°) once converged;
+//!   `markov_grid_update/global`: with every cell scored (selective update off);
+//! - `de_filter_update`: a DE filter update (population 2 000, global start).
+//!
+//! The filter is rebuilt when the drive runs out, so every update follows a real motion.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use systems::core::stream_rng;
+use systems::localization::de_filter::{DeFilter, DeFilterConfig};
+use systems::localization::fixtures::{
+    CORRIDOR, DriveStep, bench_markov_grid, bench_mcl, hospital, recorded_drive,
+};
+use systems::localization::mcl::{BeamSubset, sensor_model};
+use systems::localization::{LocalizationMap, MarkovGrid};
+
+const BEAMS: usize = 60;
+
+fn one_core<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+fn subsets(steps: &[DriveStep]) -> Vec<BeamSubset> {
+    steps
+        .iter()
+        .map(|s| BeamSubset::from_scan(&s.scan, &systems::core::Pose2::IDENTITY, BEAMS))
+        .collect()
+}
+
+fn mcl(c: &mut Criterion, map: &LocalizationMap, steps: &[DriveStep], beams: &[BeamSubset]) {
+    let mut g = c.benchmark_group("mcl_update");
+    for n in [1_000usize, 5_000, 20_000] {
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, &n| {
+            one_core(|| {
+                let mut f = bench_mcl(map, n, BEAMS, &steps[0].truth);
+                let mut k = 0;
+                b.iter(|| {
+                    if k == steps.len() {
+                        f = bench_mcl(map, n, BEAMS, &steps[0].truth);
+                        k = 0;
+                    }
+                    black_box(f.update(map, &beams[k], &steps[k].odom));
+                    k += 1;
+                })
+            })
+        });
+    }
+    g.finish();
+    let mut g = c.benchmark_group("mcl_weigh");
+    for n in [1_000usize, 5_000, 20_000] {
+        let f = bench_mcl(map, n, BEAMS, &steps[0].truth);
+        let table = sensor_model::likelihood_table(&map.field, &f.config.laser, 20.0);
+        let points = beams[0].returns();
+        g.bench_with_input(BenchmarkId::from_parameter(n), &n, |b, _| {
+            one_core(|| {
+                let mut w = f.w.clone();
+                b.iter(|| {
+                    sensor_model::weigh_likelihood_field(
+                        &map.field, &table, &points, &f.xs, &f.ys, &f.ths, &mut w,
+                    );
+                    w.iter_mut().for_each(|v| *v = 1.0);
+                    black_box(&w);
+                })
+            })
+        });
+    }
+    g.finish();
+}
+
+/// A Markov grid after `warm` updates of the drive, and the index of the next step.
+fn warmed_grid(
+    map: &LocalizationMap,
+    steps: &[DriveStep],
+    beams: &[BeamSubset],
+    threshold: f64,
+    warm: usize,
+) -> (MarkovGrid, usize) {
+    let mut g = bench_markov_grid(map, threshold);
+    for k in 0..warm {
+        g.update(map, &beams[k].returns(), beams[k].range_max, &steps[k].odom);
+    }
+    (g, warm)
+}
+
+fn markov_grid(c: &mut Criterion, map: &LocalizationMap, steps: &[DriveStep], beams: &[BeamSubset]) {
+    let mut g = c.benchmark_group("markov_grid_update");
+    g.sample_size(10);
+    for (name, threshold, warm) in [("selective", 1e-6, 20), ("global", 0.0, 0)] {
+        g.bench_function(name, |b| {
+            one_core(|| {
+                let (mut f, mut k) = warmed_grid(map, steps, beams, threshold, warm);
+                b.iter(|| {
+                    if k == steps.len() {
+                        (f, k) = warmed_grid(map, steps, beams, threshold, warm);
+                    }
+                    let pts = beams[k].returns();
+                    black_box(f.update(map, &pts, beams[k].range_max, &steps[k].odom));
+                    k += 1;
+                })
+            })
+        });
+    }
+    g.finish();
+}
+
+fn de_filter(c: &mut Criterion, map: &LocalizationMap, steps: &[DriveStep], beams: &[BeamSubset]) {
+    let config = DeFilterConfig {
+        update_min_d: 0.0,
+        update_min_a: 0.0,
+        ..DeFilterConfig::default()
+    };
+    let new = || DeFilter::new(config.clone(), map, stream_rng(0, "bench", "de"));
+    let mut g = c.benchmark_group("de_filter_update");
+    g.sample_size(20);
+    g.bench_function("2000", |b| {
+        one_core(|| {
+            let mut f = new();
+            let mut k = 0;
+            b.iter(|| {
+                if k == steps.len() {
+                    f = new();
+                    k = 0;
+                }
+                black_box(f.update(map, &beams[k], &steps[k].odom));
+                k += 1;
+            })
+        })
+    });
+    g.finish();
+}
+
+fn localization(c: &mut Criterion) {
+    let map = hospital();
+    let steps = recorded_drive(&map, &CORRIDOR, 0.0, 1);
+    let beams = subsets(&steps);
+    mcl(c, &map, &steps, &beams);
+    markov_grid(c, &map, &steps, &beams);
+    de_filter(c, &map, &steps, &beams);
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default()
+        .sample_size(30)
+        .measurement_time(std::time::Duration::from_secs(3));
+    targets = localization
+}
+criterion_main!(benches);
