@@ -153,7 +153,12 @@ pub fn filter_cloud(f: &Filter, cap: usize) -> Option<Cloud> {
 
 /// Points of the closed 2-σ ellipse of the (x, y) block of `cov` around (x, y): `segments`
 /// segments, the first point repeated at the end. None if the block is not a finite covariance.
-pub fn ellipse_2sigma(x: f64, y: f64, cov: &[[f64; 3]; 3], segments: usize) -> Option<Vec<[f32; 3]>> {
+pub fn ellipse_2sigma(
+    x: f64,
+    y: f64,
+    cov: &[[f64; 3]; 3],
+    segments: usize,
+) -> Option<Vec<[f32; 3]>> {
     let (a, b, c) = (cov[0][0], 0.5 * (cov[0][1] + cov[1][0]), cov[1][1]);
     if !(a.is_finite() && b.is_finite() && c.is_finite()) {
         return None;
@@ -171,20 +176,34 @@ pub fn ellipse_2sigma(x: f64, y: f64, cov: &[[f64; 3]; 3], segments: usize) -> O
             .map(|k| {
                 let t = std::f64::consts::TAU * (k % n) as f64 / n as f64;
                 let (u, v) = (r1 * t.cos(), r2 * t.sin());
-                [(x + co * u - s * v) as f32, (y + s * u + co * v) as f32, 0.0]
+                [
+                    (x + co * u - s * v) as f32,
+                    (y + s * u + co * v) as f32,
+                    0.0,
+                ]
             })
             .collect(),
     )
 }
 
 /// The ±2σ heading wedge: two rays of length `len` from (x, y) at θ ± 2σθ (at most ±π).
-pub fn heading_wedge(x: f64, y: f64, theta: f64, var_theta: f64, len: f64) -> Option<Vec<[f32; 3]>> {
+pub fn heading_wedge(
+    x: f64,
+    y: f64,
+    theta: f64,
+    var_theta: f64,
+    len: f64,
+) -> Option<Vec<[f32; 3]>> {
     if !(var_theta.is_finite() && var_theta >= 0.0) {
         return None;
     }
     let half = (2.0 * var_theta.sqrt()).min(std::f64::consts::PI);
     let tip = |a: f64| [(x + len * a.cos()) as f32, (y + len * a.sin()) as f32, 0.0];
-    Some(vec![tip(theta - half), [x as f32, y as f32, 0.0], tip(theta + half)])
+    Some(vec![
+        tip(theta - half),
+        [x as f32, y as f32, 0.0],
+        tip(theta + half),
+    ])
 }
 
 #[cfg(test)]

@@ -197,13 +197,12 @@ fn localizer_colour(k: usize) -> rerun::Color {
 }
 
 impl RrdRecorder {
-    /// Logs what a localizer published this tick: estimate, covariance, error series and (when
-    /// due) its particle set; the estimate path when `paths_due`.
+    /// Logs what localizer `k` of robot `robot` published this tick: estimate, covariance, error
+    /// series and (when due) its particle set; the estimate path when `paths_due`.
     fn record_localizer(
         &mut self,
         base: &str,
-        robot: usize,
-        k: usize,
+        (robot, k): (usize, usize),
         l: &Localizer,
         samples: &[systems::eval::Sample],
         now: f64,
@@ -243,9 +242,10 @@ impl RrdRecorder {
         if paired {
             for s in &samples[samples.len() - fresh..] {
                 self.rec.set_duration_secs("sim_time", s.t);
-                let res = self
-                    .rec
-                    .log(err_path.as_str(), &rerun::Scalars::single(s.position_error()));
+                let res = self.rec.log(
+                    err_path.as_str(),
+                    &rerun::Scalars::single(s.position_error()),
+                );
                 self.check(res);
                 let dth = wrap_angle(s.estimate.theta - s.truth.theta).abs();
                 let res = self
@@ -331,9 +331,9 @@ pub fn record_rrd(
     r.path_timer.due(start, now, &mut due);
     let paths_due = !due.is_empty();
     r.due = due;
-    let published = robots
-        .iter()
-        .any(|q| q.6.is_some_and(|(l, _)| l.items.iter().any(|l| !l.fresh.is_empty())));
+    let published = robots.iter().any(|q| {
+        q.6.is_some_and(|(l, _)| l.items.iter().any(|l| !l.fresh.is_empty()))
+    });
     if !(poses_due || scans_due || paths_due || published) {
         return;
     }
@@ -354,7 +354,7 @@ pub fn record_rrd(
                     .get(k)
                     .filter(|(n, _)| *n == l.name)
                     .map_or(&[][..], |(_, s)| &s[..]);
-                r.record_localizer(&base, i, k, l, s, now, paths_due);
+                r.record_localizer(&base, (i, k), l, s, now, paths_due);
             }
         }
         if !(poses_due || scans_due || paths_due) {
