@@ -163,13 +163,22 @@ pub fn run_mcl_bench(o: &LocBenchOptions) -> anyhow::Result<()> {
                 }
                 let b = &d.beams[k];
                 // the kernel alone, on the particles as they are before the update
-                let table =
-                    sensor_model::likelihood_table(&d.map.field, &f.config.laser, b.range_max as f64);
+                let table = sensor_model::likelihood_table(
+                    &d.map.field,
+                    &f.config.laser,
+                    b.range_max as f64,
+                );
                 let points = b.returns();
                 let mut w = vec![1.0; f.len()];
                 let t = Instant::now();
                 sensor_model::weigh_likelihood_field(
-                    &d.map.field, &table, &points, &f.xs, &f.ys, &f.ths, &mut w,
+                    &d.map.field,
+                    &table,
+                    &points,
+                    &f.xs,
+                    &f.ys,
+                    &f.ths,
+                    &mut w,
                 );
                 let tw = ms_since(t);
                 std::hint::black_box(&w);
@@ -234,7 +243,11 @@ pub fn run_markov_grid_bench(o: &LocBenchOptions) -> anyhow::Result<()> {
     }
     for (mode, threshold, converge) in [
         ("global", 0.0, 0),
-        ("selective", MarkovGridConfig::default().selective_threshold, GRID_CONVERGE_UPDATES),
+        (
+            "selective",
+            MarkovGridConfig::default().selective_threshold,
+            GRID_CONVERGE_UPDATES,
+        ),
     ] {
         let (times, cells, beams_used, g) = one_core(|| {
             let new = || bench_markov_grid(&d.map, threshold);

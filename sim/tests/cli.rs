@@ -169,3 +169,50 @@ fn scenarios_lists_the_bundled_ones() {
     );
     assert!(!s.contains("invalid"), "{s}");
 }
+
+/// Parses every line of a `--json` bench output and checks the fields each row must have.
+fn bench_rows(args: &[&str], fields: &[&str]) -> Vec<serde_json::Value> {
+    let dir = tempfile::tempdir().unwrap();
+    let out = sim(args, dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let rows: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
+        .collect();
+    for row in &rows {
+        for f in fields {
+            let x = row[f].as_f64().unwrap_or_else(|| panic!("no {f} in {row}"));
+            assert!(x.is_finite() && x > 0.0, "{f} = {x} in {row}");
+        }
+    }
+    rows
+}
+
+#[test]
+fn bench_mcl_prints_json_lines() {
+    let rows = bench_rows(
+        &["bench", "mcl", "--json", "--reps", "1"],
+        &["particles", "beams", "ms_per_update", "evals_per_s"],
+    );
+    let counts: Vec<u64> = rows
+        .iter()
+        .map(|r| r["particles"].as_u64().unwrap())
+        .collect();
+    assert_eq!(counts, [1000, 5000, 20000]);
+    assert!(rows.iter().all(|r| r["beams"] == 60), "{rows:?}");
+}
+
+#[test]
+fn bench_markov_grid_prints_json_lines() {
+    let rows = bench_rows(
+        &["bench", "markov-grid", "--json", "--reps", "1"],
+        &["particles", "cells", "beams", "ms_per_update"],
+    );
+    let modes: Vec<&str> = rows.iter().map(|r| r["mode"].as_str().unwrap()).collect();
+    assert_eq!(modes, ["global", "selective"]);
+}

@@ -92,7 +92,12 @@ fn warmed_grid(
     (g, warm)
 }
 
-fn markov_grid(c: &mut Criterion, map: &LocalizationMap, steps: &[DriveStep], beams: &[BeamSubset]) {
+fn markov_grid(
+    c: &mut Criterion,
+    map: &LocalizationMap,
+    steps: &[DriveStep],
+    beams: &[BeamSubset],
+) {
     let mut g = c.benchmark_group("markov_grid_update");
     g.sample_size(10);
     for (name, threshold, warm) in [("selective", 1e-6, 20), ("global", 0.0, 0)] {

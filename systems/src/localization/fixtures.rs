@@ -4,11 +4,11 @@
 
 use super::map::LocalizationMap;
 use crate::core::{Pose2, SimRng, stream_rng, wrap_angle};
-use crate::world::MapError;
-use std::path::Path;
 use crate::sensors::LaserScan;
+use crate::world::MapError;
 use crate::world::load_map;
 use rand_distr::{Distribution, StandardNormal};
+use std::path::Path;
 
 /// The first leg of the hospital's corridors: west wing → main corridor → north corridor.
 pub const CORRIDOR: [[f64; 2]; 4] = [[2.2, 16.0], [21.25, 16.0], [21.25, 24.75], [40.0, 24.75]];
@@ -94,7 +94,6 @@ pub fn drive(
         }
     }
 }
-
 
 /// One step of a recorded drive: true pose, odometry reading and the scan taken there.
 #[derive(Clone, Debug)]
