@@ -25,7 +25,8 @@
 //!    alignment puts in space the other scan saw as free ([`super::visibility`]).
 //! 6. **Final refinement**: the best screened candidates are refined on the fine set and judged
 //!    again; the best wins.
-//! 6b. **Rotation polish**: when the winner explains less than `polish_below` of the fine set
+//!
+//!    **Rotation polish**: when the winner explains less than `polish_below` of the fine set
 //!    (little overlap, e.g. 30 steps apart), the wide starting gate lets the refinement pull the
 //!    rotation towards walls only one scan saw (1.5–3° off in the 460-pair protocol). The winner
 //!    is restarted at ±1°, ±2°, ±3° with a narrow gate (`polish_gate`), each refined fully and
@@ -502,7 +503,7 @@ pub(crate) fn match_improved(
         }
     }
 
-    // 6b. rotation polish of a low-overlap winner
+    // 6b. rotation polish of a low-overlap winner (step 6 of the module docs)
     if let Some(b) = best
         && (b.2 as f64) < cfg.polish_below as f64 * cur_fine.len() as f64
     {
