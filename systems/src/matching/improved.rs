@@ -25,6 +25,12 @@
 //!    alignment puts in space the other scan saw as free ([`super::visibility`]).
 //! 6. **Final refinement**: the best screened candidates are refined on the fine set and judged
 //!    again; the best wins.
+//!
+//!    **Rotation polish**: when the winner explains less than `polish_below` of the fine set
+//!    (little overlap, e.g. 30 steps apart), the wide starting gate lets the refinement pull the
+//!    rotation towards walls only one scan saw (1.5–3° off in the 460-pair protocol). The winner
+//!    is restarted at ±1°, ±2°, ±3° with a narrow gate (`polish_gate`), each refined fully and
+//!    judged; the best judged answer wins.
 //! 7. **DE fallback** ([`super::de`]): if the winner's judged score is below `fallback_below`
 //!    of the fine set (few normals, e.g. unordered points, or heavy clutter), a DE run on the
 //!    score grid, seeded with the candidates, searches the whole window; its best member is
@@ -84,6 +90,11 @@ pub struct ImprovedConfig {
     /// Half-length (m) and step (m) of that line search.
     pub weak_search: f32,
     pub weak_step: f32,
+    /// Run the rotation polish when the winner's inlier fraction of the fine set is below this
+    /// (0 disables it).
+    pub polish_below: f32,
+    /// Starting correspondence gate (m) of the polish refinements.
+    pub polish_gate: f32,
     /// Run the DE fallback when the winner's judged score, as a fraction of the fine set, is
     /// below this (0 disables the fallback).
     pub fallback_below: f32,
@@ -104,7 +115,7 @@ impl Default for ImprovedConfig {
             fine_spacing: 0.05,
             fine_points: 400,
             screened: 24,
-            finalists: 2,
+            finalists: 3,
             screen_iterations: 6,
             final_iterations: 15,
             gate: 0.5,
@@ -114,6 +125,8 @@ impl Default for ImprovedConfig {
             weak_ratio: 0.3,
             weak_search: 0.6,
             weak_step: 0.05,
+            polish_below: 0.35,
+            polish_gate: 0.15,
             fallback_below: 0.2,
             fallback: DeParams {
                 population: 24,
@@ -160,6 +173,14 @@ impl ImprovedConfig {
         pos("improved.violation_margin", self.violation_margin)?;
         pos("improved.weak_search", self.weak_search)?;
         pos("improved.weak_step", self.weak_step)?;
+        pos("improved.polish_gate", self.polish_gate)?;
+        if !(0.0..=1.0).contains(&self.polish_below) {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.polish_below",
+                value: self.polish_below as f64,
+                expected: "a fraction in [0, 1]",
+            });
+        }
         if !(0.0..=1.0).contains(&self.weak_ratio) {
             return Err(MatchError::InvalidParameter {
                 name: "improved.weak_ratio",
@@ -432,7 +453,12 @@ pub(crate) fn match_improved(
     screened.sort_by(|a, b| b.1.total_cmp(&a.1));
 
     // 6. final refinement
-    let finalize = |start: Vector| -> (Vector, f64, usize) {
+    let narrow = RefineParams {
+        gate_start: cfg.polish_gate.max(full.gate_end),
+        ..full
+    };
+    let finalize = |start: Vector, full: &RefineParams| -> (Vector, f64, usize) {
+        let full = *full;
         let refined = refine(&judge.model, &cur_fine, start, &full);
         let mut r = keep_inside(refined.x, start);
         // weakly constrained translation (a corridor): point-to-line barely feels the few wall
@@ -470,10 +496,25 @@ pub(crate) fn match_improved(
     };
     let mut best: Option<(Vector, f64, usize)> = None;
     for &(t, _) in screened.iter().take(cfg.finalists) {
-        let c = finalize(t);
+        let c = finalize(t, &full);
         evaluations += cfg.final_iterations as u64 + 1;
         if best.is_none_or(|b| c.1 > b.1) {
             best = Some(c);
+        }
+    }
+
+    // 6b. rotation polish of a low-overlap winner (step 6 of the module docs)
+    if let Some(b) = best
+        && (b.2 as f64) < cfg.polish_below as f64 * cur_fine.len() as f64
+    {
+        let centre = b.0;
+        for deg in [-3.0f64, -2.0, -1.0, 1.0, 2.0, 3.0] {
+            let t = [centre[0], centre[1], centre[2] + deg.to_radians()];
+            let c = finalize(t, &narrow);
+            evaluations += cfg.final_iterations as u64 + 1;
+            if best.is_none_or(|bb| c.1 > bb.1) {
+                best = Some(c);
+            }
         }
     }
 
@@ -491,7 +532,7 @@ pub(crate) fn match_improved(
         evaluations += out.evaluations;
         let start = out.best;
         let quick_r = keep_inside(refine(&judge.model, &cur_coarse, start, &quick).x, start);
-        let c = finalize(quick_r);
+        let c = finalize(quick_r, &full);
         evaluations += (cfg.screen_iterations + cfg.final_iterations) as u64 + 1;
         if best.is_none_or(|b| c.1 > b.1) {
             best = Some(c);

@@ -1,9 +1,12 @@
 //! The `sim` command line: exit codes, error messages, default file names, the summary JSON.
 
+mod matching;
+
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn sim(args: &[&str], cwd: &Path) -> Output {
+/// Runs the `sim` binary with `args` in `cwd`.
+pub fn sim(args: &[&str], cwd: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sim"))
         .args(args)
         .current_dir(cwd)
