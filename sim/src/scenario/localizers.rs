@@ -73,6 +73,9 @@ impl LocalizerType {
                 "recovery_alpha_fast",
                 "injection_candidates",
                 "recovery_ratio",
+                "challenge_every",
+                "challenge_ratio",
+                "challenge_fraction",
             ],
             LocalizerType::MarkovGrid => &[
                 "max_beams",
@@ -216,6 +219,9 @@ pub struct LocalizerFile {
     pub recovery_alpha_fast: Option<f64>,
     pub injection_candidates: Option<usize>,
     pub recovery_ratio: Option<f64>,
+    pub challenge_every: Option<usize>,
+    pub challenge_ratio: Option<f64>,
+    pub challenge_fraction: Option<f64>,
     pub init: Option<InitType>,
     pub init_pose: Option<PointOrPlace>,
     /// Standard deviations of the initial Gaussian [x (m), y (m), yaw (rad)].
@@ -286,6 +292,9 @@ impl LocalizerFile {
             recovery_alpha_fast,
             injection_candidates,
             recovery_ratio,
+            challenge_every,
+            challenge_ratio,
+            challenge_fraction,
             init,
             init_pose,
             init_sd,
@@ -644,6 +653,25 @@ fn resolve_mcl(
                 10_000_000,
             )?,
         },
+        challenge_every: match l.challenge_every {
+            Some(0) => 0,
+            _ => f.count(
+                "challenge_every",
+                l.challenge_every,
+                d.challenge_every as usize,
+                1,
+                1_000_000,
+            )? as u64,
+        },
+        challenge_ratio: match l.challenge_ratio {
+            Some(v) => c.range(&p.key("challenge_ratio"), v, Some(1.0), None, false)?,
+            None => d.challenge_ratio,
+        },
+        challenge_fraction: f.prob(
+            "challenge_fraction",
+            l.challenge_fraction,
+            d.challenge_fraction,
+        )?,
         init: f.init(start, pose)?,
         bins: d.bins,
     })

@@ -329,6 +329,18 @@ fn grid_and_de_localizer_errors_name_the_key() {
         &with_localizer("[[robots.localization]]\ntype = \"mcl\"\ninjection_candidates = -5"),
         &["injection_candidates"],
     );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"mcl\"\nchallenge_ratio = 0.9"),
+        &["robots[0].localization[0].challenge_ratio", "0.9"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"mcl\"\nchallenge_fraction = 1.5"),
+        &["challenge_fraction", "1.5"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"markov_grid\"\nchallenge_every = 5"),
+        &["challenge_every", "does not apply to a `markov_grid`"],
+    );
     // every type parses with its defaults
     for t in ["mcl", "markov_grid", "de_filter", "de_mc", "de_odometry"] {
         scenario(&with_localizer(&format!(

@@ -15,6 +15,7 @@
 //! - estimate: weighted mean and covariance of the dominant cluster ([`cluster`]).
 
 pub mod cluster;
+pub mod field_kernel;
 pub mod injection;
 pub mod resample;
 pub mod sensor_model;
@@ -74,6 +75,14 @@ pub struct MclConfig {
     /// candidates per round ([`injection`]), so a kidnapped robot is found in a large building
     /// within seconds.
     pub injection_candidates: usize,
+    /// Every this many updates (0: never) the scan proposal challenges the filter: when its best
+    /// pose explains the scan `challenge_ratio` times better than the filter's best particle,
+    /// `challenge_fraction` of the particles are drawn from the proposal at the next
+    /// resampling. A filter that converged to a look-alike place is pulled out of it this way:
+    /// the weight averages cannot see a wrong place that fits the scans almost as well.
+    pub challenge_every: u64,
+    pub challenge_ratio: f64,
+    pub challenge_fraction: f64,
     pub init: InitialBelief,
     pub bins: BinSize,
 }
@@ -96,11 +105,17 @@ impl Default for MclConfig {
             recovery_alpha_fast: 0.1,
             recovery_ratio: 0.7,
             injection_candidates: 20_000,
+            challenge_every: 10,
+            challenge_ratio: 1.1,
+            challenge_fraction: 0.1,
             init: InitialBelief::Global,
             bins: BinSize::default(),
         }
     }
 }
+
+/// The heaviest particles a challenge compares the scan proposal with.
+const CHALLENGE_TOP: usize = 256;
 
 /// Particles per motion-sampling work item (each seeded from the filter's stream in order).
 const MOTION_CHUNK: usize = 1024;
@@ -287,8 +302,15 @@ impl Mcl {
             0.0
         };
         let n_eff = 1.0 / self.w.iter().map(|w| w * w).sum::<f64>();
+        let challenger = if p_inject > 0.0 {
+            None
+        } else {
+            self.challenge(map, beams)
+        };
 
-        if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
+        if let Some(pool) = challenger {
+            self.resample(map, self.config.challenge_fraction, Some(&pool));
+        } else if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
             // Unlike AMCL, the averages are not reset after an injection (Table 8.3 has no
             // reset): AMCL's reset ends the injection after one burst of a few percent, which
             // rarely finds a kidnapped robot; here random particles keep coming while the
@@ -324,6 +346,64 @@ impl Mcl {
             &mut self.rng,
         );
         (!pool.is_empty()).then_some(pool)
+    }
+
+    /// The scan proposal when it explains the scan markedly better than the filter's best
+    /// particle (see [`MclConfig::challenge_every`]); checked every `challenge_every` updates.
+    fn challenge(
+        &mut self,
+        map: &LocalizationMap,
+        beams: &BeamSubset,
+    ) -> Option<Vec<(f64, f64, f64)>> {
+        let every = self.config.challenge_every;
+        let n = self.config.injection_candidates;
+        if every == 0 || n == 0 || beams.is_empty() || self.updates % every != every - 1 {
+            return None;
+        }
+        let table = self.field_table(map, beams.range_max);
+        let points = beams.returns();
+        let pool = injection::scan_proposal(
+            map,
+            &self.config.laser,
+            &table,
+            &points,
+            beams.range_max,
+            n,
+            &mut self.rng,
+        );
+        // the filter's best explanation of this scan: the best of its heaviest particles
+        let mut top: Vec<usize> = (0..self.len()).collect();
+        let k = CHALLENGE_TOP.min(top.len());
+        if k == 0 {
+            return None;
+        }
+        top.select_nth_unstable_by(k - 1, |&a, &b| {
+            self.w[b].total_cmp(&self.w[a]).then(a.cmp(&b))
+        });
+        top.truncate(k);
+        let m = pool.len();
+        let pick = |own: &[f64], get: fn(&(f64, f64, f64)) -> f64| -> Vec<f64> {
+            pool.iter()
+                .map(get)
+                .chain(top.iter().map(|&i| own[i]))
+                .collect()
+        };
+        let xs = pick(&self.xs, |p| p.0);
+        let ys = pick(&self.ys, |p| p.1);
+        let ths = pick(&self.ths, |p| p.2);
+        let mut score = vec![1.0f64; xs.len()];
+        sensor_model::weigh_likelihood_field(
+            &map.field, &table, &points, &xs, &ys, &ths, &mut score,
+        );
+        let own = score[m..].iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+        let bar = own * self.config.challenge_ratio;
+        let challengers: Vec<(f64, f64, f64)> = pool
+            .iter()
+            .zip(&score[..m])
+            .filter(|&(_, &s)| s >= bar)
+            .map(|(p, _)| *p)
+            .collect();
+        (!challengers.is_empty()).then_some(challengers)
     }
 
     fn resample(

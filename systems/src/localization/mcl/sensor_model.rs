@@ -12,6 +12,7 @@
 //! Kernels are plain functions over particle arrays; particles are weighed in fixed chunks on the
 //! rayon pool (each weight depends on its particle only, so results do not depend on threads).
 
+use super::field_kernel::{self, GridPose};
 use crate::core::Pose2;
 use crate::raycast::RayMap;
 use crate::sensors::LaserScan;
@@ -137,11 +138,8 @@ pub fn likelihood_table(field: &DistanceField, p: &LaserModelParams, range_max: 
 
 /// Likelihood-field kernel: multiplies `w[i]` by 1 + Σ_beams table[field(endpoint of particle
 /// i)] for the beam endpoints `points` (base frame; max-range readings must be left out, as AMCL
-/// does). Endpoints outside the map read the table's last entry (distance `max_dist`).
-///
-/// The hot loop finds an endpoint's cell by truncation after a range test in grid coordinates:
-/// floor and truncation agree on [0, n), and `f32::floor` is a libm call on baseline x86-64
-/// (it was a fifth of an MCL update).
+/// does). Endpoints outside the map read the table's last entry (distance `max_dist`). The sums
+/// come from [`field_kernel`] (vectorised where the CPU allows, identical results either way).
 pub fn weigh_likelihood_field(
     field: &DistanceField,
     table: &[f32; 256],
@@ -151,31 +149,15 @@ pub fn weigh_likelihood_field(
     ths: &[f64],
     w: &mut [f64],
 ) {
-    let inv = 1.0 / field.resolution;
-    let (ox, oy) = (field.origin[0], field.origin[1]);
-    let wd = field.width;
-    let (wf, hf) = (field.width as f32, field.height as f32);
-    let cells = &field.cells;
     let far = table[crate::world::distance_field::FAR as usize];
     w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, wc)| {
         let base = c * CHUNK;
-        for (j, wi) in wc.iter_mut().enumerate() {
-            let i = base + j;
-            let (s, co) = ths[i].sin_cos();
-            // grid coordinates of the particle and its rotation, in cells
-            let gx = ((xs[i] - ox) * inv) as f32;
-            let gy = ((ys[i] - oy) * inv) as f32;
-            let (s, co) = ((s * inv) as f32, (co * inv) as f32);
-            let mut p = 1.0f32;
-            for &[bx, by] in points {
-                let x = gx + co * bx - s * by;
-                let y = gy + s * bx + co * by;
-                p += if x >= 0.0 && x < wf && y >= 0.0 && y < hf {
-                    table[cells[y as usize * wd + x as usize] as usize]
-                } else {
-                    far
-                };
-            }
+        let poses: Vec<GridPose> = (base..base + wc.len())
+            .map(|i| GridPose::new(field, xs[i], ys[i], ths[i]))
+            .collect();
+        let mut p = vec![0.0f32; wc.len()];
+        field_kernel::score_all(field, table, far, points, &poses, &mut p);
+        for (wi, p) in wc.iter_mut().zip(p) {
             *wi *= p as f64;
         }
     });

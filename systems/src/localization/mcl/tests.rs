@@ -81,6 +81,44 @@ fn converges_from_global_initialisation() {
     );
 }
 
+/// A filter sure of a wrong place (a confident Gaussian 6 m along the corridor, where the scans
+/// fit but worse) with the weight-average recovery off: the scan-proposal challenges pull it to
+/// the truth; without them it stays lost.
+#[test]
+fn challenges_pull_a_filter_out_of_a_wrong_place() {
+    let map = hospital();
+    let run = |challenge_every: u64| {
+        let config = MclConfig {
+            init: InitialBelief::Gaussian {
+                pose: Pose2::new(CORRIDOR[0][0] + 6.0, CORRIDOR[0][1], 0.0),
+                sd: [0.1, 0.1, 0.03],
+            },
+            recovery_alpha_slow: 0.0,
+            challenge_every,
+            ..tuned()
+        };
+        let mut mcl = Mcl::new(config, &map, stream_rng(3, "test", "mcl"));
+        let mut last = (f64::NAN, f64::NAN);
+        drive(&map, &CORRIDOR, 0.0, 3, |truth, odom, scan| {
+            let beams = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60);
+            if mcl.update(&map, &beams, odom) {
+                last = error(&mcl.estimate.unwrap(), truth);
+            }
+        });
+        last
+    };
+    let (d, a) = run(10);
+    assert!(
+        d < 0.2 && a < 5f64.to_radians(),
+        "with challenges: {d} m, {a} rad"
+    );
+    let (d, _) = run(0);
+    assert!(
+        d > 1.0,
+        "without challenges the filter should stay lost: {d} m"
+    );
+}
+
 /// Weighing a grid of poses around the truth: the best is within a cell of it (no bias
 /// towards the walls the beams end on).
 #[test]
