@@ -4,9 +4,9 @@
 //! ([`systems::localization::fixtures`]), so every run times the same updates.
 //!
 //! - mcl: a full update (motion sampling, likelihood-field weighing, resampling when due,
-//!   clustering) with KLD off (the set keeps its size) and no recovery injection, started around
-//!   the true pose; `ms_weigh` is the likelihood-field kernel alone, and `evals_per_s` counts
-//!   particle × beam evaluations per second of a full update.
+//!   clustering) with KLD off (the set keeps its size), no recovery injection and no
+//!   challenges, started around the true pose; `ms_weigh` is the likelihood-field kernel
+//!   alone, and `evals_per_s` counts particle × beam evaluations per second of a full update.
 //! - markov-grid: 0.25 m × 10° over the floor; `global` scores every cell at every update (the
 //!   cost before convergence), `selective` is the default selective update once converged
 //!   (after 20 warm-up updates).

@@ -122,7 +122,8 @@ pub fn recorded_drive(
 }
 
 /// The MCL of the benchmarks: `particles` particles, KLD off (always that many), the likelihood
-/// field with `beams` beams, no recovery injection, an update at every scan (no motion gate),
+/// field with `beams` beams, no recovery injection and no scan-proposal challenges (their cost
+/// comes every `challenge_every` updates), an update at every scan (no motion gate),
 /// started as a Gaussian (0.3 m, 0.1 rad) around `start`.
 pub fn bench_mcl(
     map: &LocalizationMap,
@@ -141,6 +142,7 @@ pub fn bench_mcl(
         update_min_a: 0.0,
         recovery_alpha_slow: 0.0,
         recovery_alpha_fast: 0.0,
+        challenge_every: 0,
         init: InitialBelief::Gaussian {
             pose: *start,
             sd: [0.3, 0.3, 0.1],
