@@ -1,11 +1,14 @@
 //! Driving behaviours (Control set). For now: waypoint following and a laser-based wander, both
 //! with reactive obstacle avoidance on the latest scan. They read the robot's belief
 //! ([`NavBelief`](crate::localization::NavBelief)) and its sensor readings, never ground truth.
+//! Global planning: the static [`costmap`] and A* on it.
 
 pub mod avoid;
 pub mod behaviour;
+pub mod costmap;
 
 pub use behaviour::{Behaviour, BehaviourKind, NavStatus};
+pub use costmap::{Costmap, CostmapParams};
 
 use crate::core::{SimPlugin, SimSet};
 use bevy_ecs::prelude::*;

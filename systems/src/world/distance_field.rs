@@ -85,8 +85,14 @@ fn transform_1d(f: &[f64], d: &mut [f64], v: &mut [usize], z: &mut [f64]) {
     }
 }
 
-/// Squared distances (in cells²) of a `w` × `h` window to the nearest `true` cell of `occ`.
-fn squared_distances(w: usize, h: usize, occ: impl Fn(usize, usize) -> bool) -> Vec<f64> {
+/// Squared distances (in cells², centre to centre) of a `w` × `h` window to the nearest `true`
+/// cell of `occ`; cells with no `true` cell anywhere read about 1e20. Shared with the navigation
+/// costmap, which inflates obstacles by the same exact transform.
+pub(crate) fn squared_distances(
+    w: usize,
+    h: usize,
+    occ: impl Fn(usize, usize) -> bool,
+) -> Vec<f64> {
     let mut g = vec![0.0; w * h];
     let n = w.max(h);
     let (mut f, mut d) = (vec![0.0; n], vec![0.0; n]);
