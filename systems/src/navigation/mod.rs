@@ -3,10 +3,13 @@
 //! ([`NavBelief`](crate::localization::NavBelief)) and its sensor readings, never ground truth.
 //! Global planning: the static [`costmap`] and A* on it.
 
+pub mod astar;
 pub mod avoid;
 pub mod behaviour;
 pub mod costmap;
+pub mod shortcut;
 
+pub use astar::{Path, PlanError, Planner, PlannerParams};
 pub use behaviour::{Behaviour, BehaviourKind, NavStatus};
 pub use costmap::{Costmap, CostmapParams};
 
