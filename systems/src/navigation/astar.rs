@@ -87,22 +87,32 @@ pub enum PlanError {
     },
 }
 
-/// An open-list entry. `Ord` is "should be expanded first": lower f, then higher g, then lower
-/// index (`BinaryHeap` is a max-heap).
-#[derive(Clone, Copy, Debug)]
+/// An open-list entry. `key` packs f (high half) and the complement of g (low half): both are
+/// finite and ≥ 0, where an f32's bits order like its value, so comparing keys compares f, then
+/// prefers the higher g. `Ord` is "should be expanded first": lower key, then lower index
+/// (`BinaryHeap` is a max-heap).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Node {
-    f: f32,
-    g: f32,
+    key: u64,
     idx: u32,
+}
+
+impl Node {
+    fn new(f: f32, g: f32, idx: usize) -> Self {
+        Node {
+            key: (f.to_bits() as u64) << 32 | !g.to_bits() as u64,
+            idx: idx as u32,
+        }
+    }
+
+    fn g(&self) -> f32 {
+        f32::from_bits(!(self.key as u32))
+    }
 }
 
 impl Ord for Node {
     fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .f
-            .total_cmp(&self.f)
-            .then(self.g.total_cmp(&other.g))
-            .then(other.idx.cmp(&self.idx))
+        other.key.cmp(&self.key).then(other.idx.cmp(&self.idx))
     }
 }
 
@@ -111,14 +121,6 @@ impl PartialOrd for Node {
         Some(self.cmp(other))
     }
 }
-
-impl PartialEq for Node {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Node {}
 
 const SQRT2: f32 = std::f32::consts::SQRT_2;
 
@@ -271,22 +273,19 @@ impl Planner {
         self.g[si] = 0.0;
         self.parent[si] = si as u32;
         self.mark[si] = open;
-        self.heap.push(Node {
-            f: heuristic(si),
-            g: 0.0,
-            idx: si as u32,
-        });
+        self.heap.push(Node::new(heuristic(si), 0.0, si));
         let costs = &map.costs;
         let mut expanded = 0;
         while let Some(node) = self.heap.pop() {
             let i = node.idx as usize;
-            if self.mark[i] == closed || node.g > self.g[i] {
+            let node_g = node.g();
+            if self.mark[i] == closed || node_g > self.g[i] {
                 continue; // a stale entry
             }
             self.mark[i] = closed;
             expanded += 1;
             if i == ti {
-                return (Some(node.g), expanded);
+                return (Some(node_g), expanded);
             }
             let (c, r) = (i % w, i / w);
             let west = c > 0;
@@ -303,16 +302,12 @@ impl Planner {
                 if this.mark[j] == closed {
                     return;
                 }
-                let g = node.g + len * this.step[costs[j] as usize];
+                let g = node_g + len * this.step[costs[j] as usize];
                 if this.mark[j] != open || g < this.g[j] {
                     this.g[j] = g;
                     this.parent[j] = i as u32;
                     this.mark[j] = open;
-                    this.heap.push(Node {
-                        f: g + heuristic(j),
-                        g,
-                        idx: j as u32,
-                    });
+                    this.heap.push(Node::new(g + heuristic(j), g, j));
                 }
             };
             if pe {
