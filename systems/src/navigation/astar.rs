@@ -13,17 +13,16 @@
 //!   highest g (the one nearest the goal, which keeps plateaus from being flooded), then the
 //!   lowest cell index. No hashing, no floating-point sums in varying order: the same map and
 //!   query always give the same path.
-//! - Scratch (g, parent, per-cell marks, the binary heap) lives in [`Planner`] and is reused
-//!   between queries; a generation counter marks which entries belong to the current query, so
+//! - Scratch (g, parent, per-cell marks, the open list: a binary heap over buckets of f, see
+//!   [`super::open_list`]) lives in [`Planner`] and is reused between queries; a generation counter marks which entries belong to the current query, so
 //!   no O(cells) clearing happens per query.
 //!
 //! The grid path is then shortened by line of sight ([`super::shortcut`]) into world-frame
 //! waypoints in metres: the exact start, the corners that are needed, the exact goal.
 
 use super::costmap::{Costmap, INSCRIBED};
+use super::open_list::{Entry, OpenList};
 use super::shortcut;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// Planner settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,39 +86,19 @@ pub enum PlanError {
     },
 }
 
-/// An open-list entry. `key` packs f (high half) and the complement of g (low half): both are
-/// finite and ≥ 0, where an f32's bits order like its value, so comparing keys compares f, then
-/// prefers the higher g. `Ord` is "should be expanded first": lower key, then lower index
-/// (`BinaryHeap` is a max-heap).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Node {
-    key: u64,
-    idx: u32,
-}
-
-impl Node {
-    fn new(f: f32, g: f32, idx: usize) -> Self {
-        Node {
-            key: (f.to_bits() as u64) << 32 | !g.to_bits() as u64,
-            idx: idx as u32,
-        }
-    }
-
-    fn g(&self) -> f32 {
-        f32::from_bits(!(self.key as u32))
+/// An open-list entry for a node with these f and g (cells): the key packs f (high half) and
+/// the complement of g (low half). Both are finite and ≥ 0, where an f32's bits order like its
+/// value, so comparing keys compares f, then prefers the higher g; equal keys go by lower index.
+fn entry(f: f32, g: f32, idx: usize) -> Entry {
+    Entry {
+        key: (f.to_bits() as u64) << 32 | !g.to_bits() as u64,
+        idx: idx as u32,
     }
 }
 
-impl Ord for Node {
-    fn cmp(&self, other: &Self) -> Ordering {
-        other.key.cmp(&self.key).then(other.idx.cmp(&self.idx))
-    }
-}
-
-impl PartialOrd for Node {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
+/// The g of an entry.
+fn entry_g(e: &Entry) -> f32 {
+    f32::from_bits(!(e.key as u32))
 }
 
 const SQRT2: f32 = std::f32::consts::SQRT_2;
@@ -136,7 +115,9 @@ pub struct Planner {
     /// 2·generation: opened in this query; 2·generation + 1: closed in this query.
     mark: Vec<u32>,
     generation: u32,
-    heap: BinaryHeap<Node>,
+    open_list: OpenList,
+    /// Largest increase of f along one move (cells), for the open list's buckets.
+    spread: f32,
 }
 
 impl Planner {
@@ -160,7 +141,8 @@ impl Planner {
             parent: Vec::new(),
             mark: Vec::new(),
             generation: 0,
-            heap: BinaryHeap::new(),
+            open_list: OpenList::default(),
+            spread: SQRT2 * (2.0 + w),
         }
     }
 
@@ -176,7 +158,6 @@ impl Planner {
             self.mark.fill(0);
             self.generation = 1;
         }
-        self.heap.clear();
     }
 
     /// The least-cost path from world point `start` to `goal` (m) on `map`.
@@ -273,12 +254,13 @@ impl Planner {
         self.g[si] = 0.0;
         self.parent[si] = si as u32;
         self.mark[si] = open;
-        self.heap.push(Node::new(heuristic(si), 0.0, si));
+        self.open_list.reset(self.spread, heuristic(si));
+        self.open_list.push(entry(heuristic(si), 0.0, si));
         let costs = &map.costs;
         let mut expanded = 0;
-        while let Some(node) = self.heap.pop() {
+        while let Some(node) = self.open_list.pop() {
             let i = node.idx as usize;
-            let node_g = node.g();
+            let node_g = entry_g(&node);
             if self.mark[i] == closed || node_g > self.g[i] {
                 continue; // a stale entry
             }
@@ -307,7 +289,7 @@ impl Planner {
                     this.g[j] = g;
                     this.parent[j] = i as u32;
                     this.mark[j] = open;
-                    this.heap.push(Node::new(g + heuristic(j), g, j));
+                    this.open_list.push(entry(g + heuristic(j), g, j));
                 }
             };
             if pe {

@@ -7,6 +7,7 @@ pub mod astar;
 pub mod avoid;
 pub mod behaviour;
 pub mod costmap;
+pub mod open_list;
 pub mod shortcut;
 
 pub use astar::{Path, PlanError, Planner, PlannerParams};

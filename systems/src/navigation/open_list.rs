@@ -1,0 +1,172 @@
+//! The A* open list: a binary heap split into buckets of f (a two-level bucket queue in the
+//! spirit of Cherkassky, Goldberg & Radzik, "Shortest paths algorithms: theory and experimental
+//! evaluation", Math. Programming 73, 1996). Only the lowest bucket is a binary heap; later
+//! buckets are plain vectors, heapified when they become the lowest. With a consistent heuristic
+//! f never decreases along a search and a node's f exceeds its parent's by at most a bounded
+//! `spread`, so a ring of buckets covering `spread` holds every entry (a spill list catches
+//! rounding surprises). Pops come out in exactly the order of a single binary heap over the same
+//! keys — the heaps are just a few hundred entries instead of tens of thousands.
+
+use std::collections::BinaryHeap;
+
+/// An entry: `key` orders first (lower is popped first), then `idx` (lower first). The high 32
+/// bits of `key` must be the bits of f (finite, ≥ 0), which buckets are taken from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Entry {
+    pub key: u64,
+    pub idx: u32,
+}
+
+impl Ord for Entry {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        // reversed: BinaryHeap is a max-heap
+        other.key.cmp(&self.key).then(other.idx.cmp(&self.idx))
+    }
+}
+
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+const RING: usize = 64;
+
+#[derive(Clone, Debug, Default)]
+pub struct OpenList {
+    /// Buckets per unit of f.
+    inv_width: f32,
+    /// Bucket number of `heap`; lower-numbered entries go there too.
+    base: u64,
+    heap: BinaryHeap<Entry>,
+    /// Bucket b (base < b < base + RING) is `ring[b % RING]`.
+    ring: Vec<Vec<Entry>>,
+    /// Entries beyond the ring (not expected with a consistent heuristic).
+    spill: Vec<Entry>,
+    /// Entries in `ring` and `spill`.
+    pending: usize,
+}
+
+impl OpenList {
+    /// Empties the list for a search whose f rises by at most `spread` per step and whose first
+    /// entry has f = `f0`.
+    pub fn reset(&mut self, spread: f32, f0: f32) {
+        if self.ring.len() != RING {
+            self.ring = vec![Vec::new(); RING];
+        }
+        self.heap.clear();
+        for b in &mut self.ring {
+            b.clear();
+        }
+        self.spill.clear();
+        self.pending = 0;
+        let spread = if spread.is_finite() && spread > 0.0 {
+            spread
+        } else {
+            1.0
+        };
+        self.inv_width = (RING - 2) as f32 / spread;
+        self.base = self.bucket(f0);
+    }
+
+    fn bucket(&self, f: f32) -> u64 {
+        (f * self.inv_width) as u64
+    }
+
+    pub fn push(&mut self, e: Entry) {
+        let b = self.bucket(f32::from_bits((e.key >> 32) as u32));
+        if b <= self.base {
+            self.heap.push(e);
+        } else if b - self.base < RING as u64 {
+            self.ring[(b % RING as u64) as usize].push(e);
+            self.pending += 1;
+        } else {
+            self.spill.push(e);
+            self.pending += 1;
+        }
+    }
+
+    pub fn pop(&mut self) -> Option<Entry> {
+        loop {
+            if let Some(e) = self.heap.pop() {
+                return Some(e);
+            }
+            if self.pending == 0 {
+                return None;
+            }
+            let ring_empty = self.ring.iter().all(|b| b.is_empty());
+            if ring_empty {
+                // only spilled entries left: jump to the lowest of them
+                let lowest = self.spill.iter().map(|e| e.key).min().unwrap_or(0);
+                self.base = self.bucket(f32::from_bits((lowest >> 32) as u32));
+            } else {
+                self.base += 1;
+            }
+            let slot = (self.base % RING as u64) as usize;
+            self.pending -= self.ring[slot].len();
+            self.heap.extend(self.ring[slot].drain(..));
+            if !self.spill.is_empty() {
+                // move spilled entries that now fall inside the ring
+                let spill = std::mem::take(&mut self.spill);
+                self.pending -= spill.len();
+                for e in spill {
+                    self.push(e);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn entry(f: f32, g: f32, idx: u32) -> Entry {
+        Entry {
+            key: (f.to_bits() as u64) << 32 | !g.to_bits() as u64,
+            idx,
+        }
+    }
+
+    #[test]
+    fn pops_in_the_order_of_one_binary_heap() {
+        let mut state = 7u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as u32
+        };
+        let mut open = OpenList::default();
+        open.reset(4.0, 10.0);
+        let mut heap = BinaryHeap::new();
+        let mut f_min = 10.0f32;
+        let mut popped = 0;
+        for round in 0..2000 {
+            // pushes within the spread of the last pop, some far beyond it, ties in f
+            for k in 0..3 {
+                let f = match k {
+                    0 => f_min + (next() % 400) as f32 / 100.0,
+                    1 => f_min + (next() % 4) as f32,
+                    _ if round % 97 == 0 => f_min + 50.0,
+                    _ => f_min,
+                };
+                let e = entry(f, (next() % 50) as f32 / 7.0, next() % 1000);
+                open.push(e);
+                heap.push(e);
+            }
+            for _ in 0..2 {
+                let (a, b) = (open.pop(), heap.pop());
+                assert_eq!(a, b, "after {popped} pops");
+                if let Some(e) = a {
+                    f_min = f32::from_bits((e.key >> 32) as u32);
+                    popped += 1;
+                }
+            }
+        }
+        while let Some(b) = heap.pop() {
+            assert_eq!(open.pop(), Some(b));
+        }
+        assert_eq!(open.pop(), None);
+    }
+}
