@@ -30,7 +30,7 @@ impl PartialOrd for Entry {
     }
 }
 
-const RING: usize = 64;
+const RING: usize = 256;
 
 #[derive(Clone, Debug, Default)]
 pub struct OpenList {
@@ -94,7 +94,7 @@ impl OpenList {
             if self.pending == 0 {
                 return None;
             }
-            let ring_empty = self.ring.iter().all(|b| b.is_empty());
+            let ring_empty = self.pending == self.spill.len();
             if ring_empty {
                 // only spilled entries left: jump to the lowest of them
                 let lowest = self.spill.iter().map(|e| e.key).min().unwrap_or(0);
