@@ -393,6 +393,14 @@ def main():
         x, y, yaw = places[name]
         kind = name.rstrip("0123456789_").rsplit("_", 1)[0] if name[-1].isdigit() else name.split("_")[0]
         lines += [f"[places.{name}]", f"pose = [{x:.3f}, {y:.3f}, {yaw:.4f}]", f'kind = "{kind}"', ""]
+    # fire doors across the two cross corridors, between the main and the south corridor: open
+    # in the map, closed by scenario events (a closed one forces robots round by the other)
+    doors = {"fire_door_w": ((19.9, 11.6), (22.6, 11.6)), "fire_door_e": ((41.9, 11.6), (44.6, 11.6))}
+    lines += ["# Doors: wall segments a scenario event can close (open in the map image).", ""]
+    for name in sorted(doors):
+        (x0, y0), (x1, y1) = doors[name]
+        lines += [f"[doors.{name}]", f"from = [{x0:.3f}, {y0:.3f}]", f"to = [{x1:.3f}, {y1:.3f}]",
+                  "thickness = 0.15", ""]
     write_or_check(d / "places.toml", "\n".join(lines).encode(), check, changed)
     print(f"hospital: {g.w} x {g.h} cells, {len(places)} places, all reachable")
 

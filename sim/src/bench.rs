@@ -97,6 +97,7 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
             laser: Some(swarm_laser(beams)),
             encoder: None,
             localizers: Vec::new(),
+            navigation: None,
         });
     }
     Scenario {
@@ -111,6 +112,8 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
         record: RecordConfig::default(),
         robots,
         events: Vec::new(),
+        doors: Vec::new(),
+        end_when_done: false,
     }
 }
 

@@ -10,17 +10,17 @@ use systems::body::{
 use systems::core::{
     KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimSet, new_schedule, stream_rng,
 };
-use systems::eval::{EvalPlugin, LocalizationSamples, RobotMetrics};
+use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome, RobotMetrics};
 use systems::localization::de_filter::DeFilter;
 use systems::localization::de_mc::DeMc;
 use systems::localization::de_odometry::DeOdometry;
 use systems::localization::{
     Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
-    OdometryModel, WheelOdometry,
+    NavSource, OdometryModel, WheelOdometry,
 };
-use systems::navigation::{Behaviour, NavigationPlugin};
+use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
 use systems::sensors::{Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin};
-use systems::world::StaticWorld;
+use systems::world::{Door, Doors, StaticWorld};
 
 /// A world ready to step.
 pub struct SimWorld {
@@ -51,7 +51,21 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
     world.insert_resource(SimClock::new(scenario.dt));
     let mut static_world = StaticWorld::new(scenario.grid.clone());
     let mut physics = Physics::new(&mut static_world, scenario.dt);
+    // one shared costmap per distinct inflation setting of the robots with tasks
+    let nav_params: Vec<_> = scenario
+        .robots
+        .iter()
+        .filter_map(|r| r.navigation.as_ref().map(|n| n.costmap))
+        .collect();
+    let costmaps = (!nav_params.is_empty()).then(|| NavCostmaps::new(&static_world, &nav_params));
     world.insert_resource(static_world);
+    world.insert_resource(Doors {
+        doors: scenario
+            .doors
+            .iter()
+            .map(|d| Door::new(d.name.clone(), d.from, d.to, d.thickness))
+            .collect(),
+    });
     // the map localizers believe in: the floor plan as it is at the start
     let any_localizer = scenario.robots.iter().any(|r| !r.localizers.is_empty());
     let field_max_dist = scenario
@@ -69,7 +83,23 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
     for (i, r) in scenario.robots.iter().enumerate() {
         let body = physics.add_robot(i as u32, &r.start, &r.footprint);
         let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body);
+        if let (Some(nav), Some(maps)) = (&r.navigation, &costmaps) {
+            let mut params = nav.params.clone();
+            params.costmap = maps.index_of(&nav.costmap).unwrap_or(0);
+            let mut ent = world.entity_mut(e);
+            ent.remove::<Behaviour>();
+            ent.insert((
+                Navigator::new(params, nav.tasks.clone()),
+                NavOutcome::default(),
+            ));
+            if let Some(l) = nav.localizer {
+                ent.insert(NavSource::new(l));
+            }
+        }
         robots.push(e);
+    }
+    if let Some(maps) = costmaps {
+        world.insert_resource(maps);
     }
     world.insert_resource(physics);
     world.insert_resource(EventQueue::new(

@@ -52,6 +52,10 @@ enum Command {
         /// Write ground truth and every localizer's estimates here in TUM format (for evo).
         #[arg(long)]
         trajectories: Option<PathBuf>,
+        /// Write the event log here: scenario events and navigation events (task started,
+        /// stops, re-plans, giving way, failures), one `time robot text` line each.
+        #[arg(long)]
+        log: Option<PathBuf>,
     },
     /// List the bundled scenarios.
     Scenarios,
@@ -279,6 +283,7 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
             threads,
             quiet,
             trajectories,
+            log,
         } => {
             let arg = scenario.unwrap_or_else(|| DEFAULT_SCENARIO.to_string());
             let path = find_scenario(&arg).ok_or_else(|| {
@@ -343,6 +348,15 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
                         dir.display()
                     );
                 }
+            }
+            if let Some(p) = &log {
+                let mut text = String::new();
+                for (t, robot, what) in &out.log {
+                    let who = if robot.is_empty() { "-" } else { robot };
+                    text += &format!("{t:9.2} {who:<12} {what}\n");
+                }
+                std::fs::write(p, text)
+                    .map_err(|e| anyhow::anyhow!("{}: cannot write the log: {e}", p.display()))?;
             }
             if let Some(p) = summary {
                 let json = serde_json::to_string_pretty(&out.summary)?;

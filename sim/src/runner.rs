@@ -2,19 +2,19 @@
 //! progress (simulated time and real-time factor), records, and gathers the summary.
 
 use crate::build::{SimWorld, build_world};
-use crate::record::{RrdRecorder, record_rrd};
+use crate::record::{RrdRecorder, record_navigation, record_rrd};
 use crate::scans::ScanRecord;
 use crate::scenario::Scenario;
-use crate::summary::{RobotSummary, Summary};
+use crate::summary::{NavigationFailure, NavigationSummary, RobotSummary, Summary};
 use bevy_ecs::prelude::*;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
 use systems::body::TruePose;
 use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
-use systems::eval::{LocalizationSamples, LocalizerMetrics, RobotMetrics, Sample};
+use systems::eval::{LocalizationSamples, LocalizerMetrics, NavOutcome, RobotMetrics, Sample};
 use systems::localization::Localizers;
-use systems::navigation::{Behaviour, NavStatus};
+use systems::navigation::{Behaviour, NavStatus, Navigator};
 use systems::sensors::{LaserScans, LaserTruth};
 
 #[derive(Clone, Debug, Default)]
@@ -50,6 +50,47 @@ pub struct RunOutput {
     /// Captured scans ([`run_scenario_capturing`]; empty otherwise), in time order, robots in
     /// index order within a tick; `index` counts from 0.
     pub scans: Vec<ScanRecord>,
+    /// What happened, in time order: scenario events and every navigator's events
+    /// (time, robot name or "" for world events, text).
+    pub log: Vec<(f64, String, String)>,
+}
+
+/// True when the scenario asks to end once every robot with tasks is done, and they are.
+fn tasks_all_done(w: &mut World) -> bool {
+    let mut q = w.query::<&Navigator>();
+    let mut any = false;
+    for n in q.iter(w) {
+        any = true;
+        if !n.finished() {
+            return false;
+        }
+    }
+    any
+}
+
+fn event_log(w: &mut World) -> Vec<(f64, String, String)> {
+    let mut log = w
+        .get_resource::<crate::script::EventQueue>()
+        .map(|q| q.fired.clone())
+        .unwrap_or_default();
+    let mut q = w.query::<(&RobotIndex, &RobotId, &Navigator, &NavOutcome)>();
+    let mut navs: Vec<_> = q.iter(w).collect();
+    navs.sort_by_key(|(i, ..)| **i);
+    for (_, id, n, o) in navs {
+        log.extend(
+            n.events
+                .iter()
+                .map(|e| (e.time, id.0.clone(), e.text.clone())),
+        );
+        log.extend(
+            o.collision_log
+                .iter()
+                .map(|(t, e)| (*t, id.0.clone(), e.clone())),
+        );
+    }
+    // stable: same-time lines keep world events first, then robots in index order
+    log.sort_by(|a, b| a.0.total_cmp(&b.0));
+    log
 }
 
 /// The estimate/truth samples of one robot's localizers.
@@ -167,7 +208,11 @@ fn run(
     if let Some(path) = &opts.rrd {
         let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
         sim.world.insert_resource(rec);
-        sim.schedule.add_systems(record_rrd.in_set(SimSet::Record));
+        sim.schedule.add_systems(
+            (record_rrd, record_navigation)
+                .chain()
+                .in_set(SimSet::Record),
+        );
     }
     let ticks = (scenario.duration / scenario.dt).round().max(1.0) as u64;
     let bar = if opts.progress {
@@ -186,6 +231,7 @@ fn run(
     let mut trajectory = Vec::new();
     let mut next_sample = 0.0;
     let update_every = (ticks / 500).max(1);
+    let mut ticks_run = ticks;
     for tick in 0..ticks {
         if let Some(period) = opts.trajectory_period {
             let t = sim.time();
@@ -208,6 +254,10 @@ fn run(
                 sim_t / wall
             ));
         }
+        if scenario.end_when_done && tasks_all_done(&mut sim.world) {
+            ticks_run = tick + 1;
+            break;
+        }
     }
     bar.finish_and_clear();
     let wall_time_s = started.elapsed().as_secs_f64();
@@ -217,7 +267,7 @@ fn run(
     if opts.trajectory_period.is_some() {
         trajectory.push((sim.time(), truth_poses(&mut sim.world)));
     }
-    let sim_time_s = ticks as f64 * scenario.dt;
+    let sim_time_s = ticks_run as f64 * scenario.dt;
     let summary = Summary {
         scenario: scenario.name.clone(),
         seed: scenario.seed,
@@ -231,6 +281,7 @@ fn run(
         trajectory,
         localization: robot_localization(&mut sim.world),
         scans: capturer.map(|c| c.scans).unwrap_or_default(),
+        log: event_log(&mut sim.world),
     })
 }
 
@@ -240,12 +291,13 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
         &RobotId,
         &TruePose,
         &RobotMetrics,
-        &Behaviour,
+        Option<&Behaviour>,
         Option<(&Localizers, &LocalizationSamples)>,
+        Option<(&Navigator, &NavOutcome)>,
     )>();
     let mut rows: Vec<(RobotIndex, RobotSummary)> = q
         .iter(w)
-        .map(|(i, id, truth, m, b, loc)| {
+        .map(|(i, id, truth, m, b, loc, nav)| {
             let localization = match loc {
                 Some((locs, samples)) => locs
                     .items
@@ -281,16 +333,51 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                         0.0
                     },
                     odometry_heading_error_rad: m.odometry_heading_error_rad,
-                    waypoints_reached: b.reached,
-                    route_completed: b.status == NavStatus::Arrived,
+                    waypoints_reached: b.map_or(0, |b| b.reached),
+                    route_completed: b.is_some_and(|b| b.status == NavStatus::Arrived),
                     final_pose: [p.x, p.y, p.theta],
                     localization,
+                    navigation: nav.map(|(n, o)| navigation_summary(n, o, m)),
                 },
             )
         })
         .collect();
     rows.sort_by_key(|(i, _)| *i);
     rows.into_iter().map(|(_, r)| r).collect()
+}
+
+fn navigation_summary(n: &Navigator, o: &NavOutcome, m: &RobotMetrics) -> NavigationSummary {
+    let nm = &n.metrics;
+    let times = &nm.delivery_times_s;
+    NavigationSummary {
+        tasks: n.tasks.len() as u32,
+        tasks_completed: nm.tasks_completed,
+        tasks_failed: nm.tasks_failed,
+        all_tasks_done: n.finished(),
+        deliveries_completed: nm.deliveries_completed,
+        delivery_times_s: times.clone(),
+        mean_delivery_time_s: (!times.is_empty())
+            .then(|| times.iter().sum::<f64>() / times.len() as f64),
+        legs: o.legs,
+        path_length_m: o.driven_m,
+        optimal_length_m: o.optimal_m,
+        path_ratio: (o.optimal_m > 0.0).then(|| o.path_ratio()),
+        collisions: m.collisions.total(),
+        wall_collisions: m.collisions.wall,
+        stops: nm.stops,
+        waiting_time_s: nm.waiting_time_s,
+        replans: nm.replans,
+        yields: nm.yields,
+        failures: nm
+            .failures
+            .iter()
+            .map(|f| NavigationFailure {
+                time_s: f.time,
+                task: f.task.clone(),
+                reason: f.reason.clone(),
+            })
+            .collect(),
+    }
 }
 
 fn robot_localization(w: &mut World) -> Vec<RobotLocalization> {

@@ -1,16 +1,21 @@
 //! Script set: timed scenario events fire at the first tick starting at or after their time:
-//! new waypoints, teleporting (kidnapping) a robot, sensor faults on and off.
+//! new waypoints, teleporting (kidnapping) a robot, sensor faults on and off, doors opening and
+//! closing. A door edits the static world (ray map, colliders, navigation costmaps follow its
+//! version) and the map the localizers believe in: the building tells its robots.
 
 use crate::scenario::{Event, EventAction, RobotConfig, SensorName};
 use bevy_ecs::prelude::*;
 use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::SimClock;
+use systems::localization::LocalizationMap;
 use systems::navigation::Behaviour;
 use systems::sensors::{Encoder, Laser};
+use systems::world::{Doors, StaticWorld};
 
 #[derive(Resource)]
 pub struct EventQueue {
-    events: Vec<(Event, Entity)>,
+    /// Each event with its robot's entity (None for world events).
+    events: Vec<(Event, Option<Entity>)>,
     next: usize,
     /// Events fired so far (time, robot, description), for logs and summaries.
     pub fired: Vec<(f64, String, String)>,
@@ -20,9 +25,12 @@ impl EventQueue {
     pub fn new(events: Vec<Event>, robots: &[RobotConfig], entities: &[Entity]) -> Self {
         let events = events
             .into_iter()
-            .filter_map(|e| {
-                let i = robots.iter().position(|r| r.name == e.robot)?;
-                Some((e, entities[i]))
+            .filter_map(|e| match &e.robot {
+                None => Some((e, None)),
+                Some(name) => {
+                    let i = robots.iter().position(|r| &r.name == name)?;
+                    Some((e, Some(entities[i])))
+                }
             })
             .collect();
         EventQueue {
@@ -33,13 +41,16 @@ impl EventQueue {
     }
 }
 
-#[allow(clippy::type_complexity)]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn fire_events(
     clock: Res<SimClock>,
     mut queue: ResMut<EventQueue>,
     mut physics: ResMut<Physics>,
+    mut world: ResMut<StaticWorld>,
+    mut doors: ResMut<Doors>,
+    mut belief_map: Option<ResMut<LocalizationMap>>,
     mut robots: Query<(
-        &mut Behaviour,
+        Option<&mut Behaviour>,
         &PhysicsBody,
         &mut TruePose,
         Option<&mut Laser>,
@@ -50,11 +61,26 @@ pub fn fire_events(
     while queue.next < queue.events.len() && queue.events[queue.next].0.at <= now + 1e-9 {
         let (event, entity) = queue.events[queue.next].clone();
         queue.next += 1;
-        let Ok((mut behaviour, body, mut truth, laser, encoder)) = robots.get_mut(entity) else {
+        if let EventAction::Door { index, open } = event.action {
+            let edits = doors.set(index, open, &mut world);
+            if let Some(m) = belief_map.as_mut() {
+                m.set_cells(&edits);
+            }
+            let name = doors.doors.get(index).map_or("?", |d| d.name.as_str());
+            let what = format!("door {name} {}", if open { "opened" } else { "closed" });
+            queue.fired.push((now, String::new(), what));
+            continue;
+        }
+        let Some(Ok((behaviour, body, mut truth, laser, encoder))) =
+            entity.map(|e| robots.get_mut(e))
+        else {
             continue;
         };
         let what = match &event.action {
             EventAction::Waypoints { points, looping } => {
+                let Some(mut behaviour) = behaviour else {
+                    continue; // a robot with tasks ignores routes (resolve rejects this)
+                };
                 behaviour.set_waypoints(points.clone(), *looping);
                 format!("new route of {} waypoints", points.len())
             }
@@ -85,7 +111,10 @@ pub fn fire_events(
                     if *active { "on" } else { "off" }
                 )
             }
+            EventAction::Door { .. } => continue, // handled above
         };
-        queue.fired.push((now, event.robot.clone(), what));
+        queue
+            .fired
+            .push((now, event.robot.clone().unwrap_or_default(), what));
     }
 }

@@ -35,6 +35,47 @@ pub struct RobotSummary {
     pub final_pose: [f64; 3],
     /// Accuracy of each localizer, by name.
     pub localization: BTreeMap<String, LocalizerMetrics>,
+    /// Task-driven navigation outcomes (robots with tasks only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<NavigationSummary>,
+}
+
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct NavigationSummary {
+    pub tasks: u32,
+    pub tasks_completed: u32,
+    pub tasks_failed: u32,
+    /// Every task done or failed.
+    pub all_tasks_done: bool,
+    pub deliveries_completed: u32,
+    /// Each completed delivery, from taking the task to the end of unloading (s).
+    pub delivery_times_s: Vec<f64>,
+    pub mean_delivery_time_s: Option<f64>,
+    /// Legs (drives to a goal) completed.
+    pub legs: u32,
+    /// True distance driven on those legs (m) ...
+    pub path_length_m: f64,
+    /// ... against the A* optimum from the true start of each leg (m) ...
+    pub optimal_length_m: f64,
+    /// ... and their ratio.
+    pub path_ratio: Option<f64>,
+    /// Contact starts with walls and with other robots during the run.
+    pub collisions: u32,
+    pub wall_collisions: u32,
+    /// Stops for obstacles, and the time spent stopped or waiting aside (s).
+    pub stops: u32,
+    pub waiting_time_s: f64,
+    pub replans: u32,
+    /// Times the robot gave way to another robot.
+    pub yields: u32,
+    pub failures: Vec<NavigationFailure>,
+}
+
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct NavigationFailure {
+    pub time_s: f64,
+    pub task: String,
+    pub reason: String,
 }
 
 impl Summary {
@@ -76,6 +117,50 @@ impl Summary {
                 r.odometry_drift_percent,
                 r.waypoints_reached
             );
+        }
+        let with_nav: Vec<(&str, &NavigationSummary)> = self
+            .robots
+            .iter()
+            .filter_map(|r| r.navigation.as_ref().map(|n| (r.name.as_str(), n)))
+            .collect();
+        if !with_nav.is_empty() {
+            s += &format!(
+                "\n{:<16} {:>7} {:>6} {:>11} {:>10} {:>9} {:>7} {:>6} {:>9} {:>8} {:>7}\n",
+                "robot",
+                "tasks",
+                "failed",
+                "deliveries",
+                "mean s",
+                "path m",
+                "ratio",
+                "stops",
+                "waited s",
+                "replans",
+                "yields"
+            );
+            for (name, n) in &with_nav {
+                s += &format!(
+                    "{:<16} {:>7} {:>6} {:>11} {:>10} {:>9.1} {:>7} {:>6} {:>9.1} {:>8} {:>7}\n",
+                    name,
+                    format!("{}/{}", n.tasks_completed, n.tasks),
+                    n.tasks_failed,
+                    n.deliveries_completed,
+                    n.mean_delivery_time_s
+                        .map_or("-".to_string(), |v| format!("{v:.1}")),
+                    n.path_length_m,
+                    n.path_ratio.map_or("-".to_string(), |v| format!("{v:.3}")),
+                    n.stops,
+                    n.waiting_time_s,
+                    n.replans,
+                    n.yields
+                );
+                for f in &n.failures {
+                    s += &format!(
+                        "  {name}: task {} failed at {:.1} s: {}\n",
+                        f.task, f.time_s, f.reason
+                    );
+                }
+            }
         }
         let with_loc: Vec<&RobotSummary> = self
             .robots

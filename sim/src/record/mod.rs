@@ -2,8 +2,10 @@
 //! every localizer. MCAP replays come later.
 
 pub mod belief;
+pub mod navigation;
 pub mod rrd;
 pub mod tum;
 
+pub use navigation::record_navigation;
 pub use rrd::{RrdRecorder, record_rrd};
 pub use tum::write_trajectories;

@@ -39,7 +39,7 @@ const PATH_SPACING: f64 = 0.05;
 
 #[derive(Resource)]
 pub struct RrdRecorder {
-    rec: rerun::RecordingStream,
+    pub(super) rec: rerun::RecordingStream,
     pose_timer: RateTimer,
     scan_timer: RateTimer,
     path_timer: RateTimer,
@@ -126,7 +126,7 @@ impl RrdRecorder {
         Ok(r)
     }
 
-    fn check(&mut self, res: rerun::RecordingStreamResult<()>) {
+    pub(super) fn check(&mut self, res: rerun::RecordingStreamResult<()>) {
         if let Err(e) = res {
             self.error.get_or_insert_with(|| e.to_string());
         }
@@ -147,17 +147,13 @@ impl RrdRecorder {
                 Cell::Unknown => 255,
             })
             .collect();
-        let map = rerun::GridMap::new(
+        let map = grid_map(
             data,
-            rerun::components::ImageFormat::from_color_model(
-                [grid.width as u32, grid.height as u32],
-                rerun::ColorModel::L,
-                rerun::ChannelDatatype::U8,
-            ),
-            grid.resolution as f32,
-        )
-        .with_translation([grid.origin[0] as f32, grid.origin[1] as f32, -0.01])
-        .with_colormap(rerun::components::Colormap::RvizMap);
+            [grid.width, grid.height],
+            grid.resolution,
+            [grid.origin[0], grid.origin[1], -0.01],
+            rerun::components::Colormap::RvizMap,
+        );
         let res = self.rec.log_static("world/map", &map);
         self.check(res);
     }
@@ -173,6 +169,27 @@ impl RrdRecorder {
             None => Ok(()),
         }
     }
+}
+
+/// A GridMap of one byte per cell (row 0 at the origin corner, as ROS and GridMap expect).
+pub(super) fn grid_map(
+    data: Vec<u8>,
+    size: [usize; 2],
+    resolution: f64,
+    origin: [f64; 3],
+    colormap: rerun::components::Colormap,
+) -> rerun::GridMap {
+    rerun::GridMap::new(
+        data,
+        rerun::components::ImageFormat::from_color_model(
+            [size[0] as u32, size[1] as u32],
+            rerun::ColorModel::L,
+            rerun::ChannelDatatype::U8,
+        ),
+        resolution as f32,
+    )
+    .with_translation([origin[0] as f32, origin[1] as f32, origin[2] as f32])
+    .with_colormap(colormap)
 }
 
 fn arrow(p: &Pose2, len: f32, c: rerun::Color) -> rerun::Arrows3D {

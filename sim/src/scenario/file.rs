@@ -11,6 +11,8 @@ pub struct ScenarioFile {
     pub seed: Option<u64>,
     pub dt: Option<f64>,
     pub duration: Option<f64>,
+    /// End the run once every robot with tasks is done (default false: run `duration`).
+    pub end_when_done: Option<bool>,
     pub map: Option<MapFile>,
     #[serde(default)]
     pub walls: Vec<WallFile>,
@@ -87,6 +89,54 @@ pub struct RobotFile {
     /// Localizers (`[[robots.localization]]` tables or an inline array).
     #[serde(default)]
     pub localization: Vec<super::localizers::LocalizerFile>,
+    /// Planner, follower and stop-and-wait settings of a robot with tasks.
+    pub navigation: Option<NavigationFile>,
+    /// The robot's task queue (`[[robots.tasks]]`).
+    #[serde(default)]
+    pub tasks: Vec<TaskFile>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct NavigationFile {
+    /// Name of the localizer to navigate by (default: wheel odometry).
+    pub localizer: Option<String>,
+    pub speed: Option<f64>,
+    pub max_accel: Option<f64>,
+    pub max_yaw_rate: Option<f64>,
+    pub tolerance: Option<f64>,
+    pub lookahead: Option<f64>,
+    /// Added to the robot radius for the costmap's impassable band (m).
+    pub safety_margin: Option<f64>,
+    pub inflation_radius: Option<f64>,
+    pub cost_weight: Option<f64>,
+    pub stop_distance: Option<f64>,
+    pub wait_time: Option<f64>,
+    pub priority: Option<u32>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum TaskType {
+    Delivery,
+    Go,
+    Wait,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct TaskFile {
+    #[serde(rename = "type")]
+    pub kind: TaskType,
+    pub name: Option<String>,
+    pub from: Option<PointOrPlace>,
+    pub to: Option<PointOrPlace>,
+    /// Loading time at `from` (s).
+    pub load: Option<f64>,
+    /// Unloading time at `to` (s).
+    pub unload: Option<f64>,
+    /// Waiting time of a `wait` task (s).
+    pub time: Option<f64>,
 }
 
 /// A point given as coordinates or as the name of a place.
@@ -191,6 +241,7 @@ pub enum EventType {
     #[serde(alias = "kidnap")]
     Teleport,
     SensorFault,
+    Door,
 }
 
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
@@ -207,7 +258,8 @@ pub struct EventFile {
     pub at: f64,
     #[serde(rename = "type")]
     pub kind: EventType,
-    pub robot: String,
+    /// The robot (every event but `door`).
+    pub robot: Option<String>,
     // waypoints
     pub points: Option<Vec<PointOrPlace>>,
     #[serde(rename = "loop")]
@@ -218,6 +270,9 @@ pub struct EventFile {
     pub sensor: Option<SensorName>,
     /// true: the fault starts (sensor silent); false: it ends.
     pub active: Option<bool>,
+    // door
+    pub door: Option<String>,
+    pub open: Option<bool>,
 }
 
 /// Named places next to a map: `[places.<name>] pose = [x, y, yaw]`.
@@ -226,6 +281,17 @@ pub struct EventFile {
 pub struct PlacesFile {
     #[serde(default)]
     pub places: std::collections::BTreeMap<String, PlaceFile>,
+    /// Doors: `[doors.<name>] from = [x, y], to = [x, y], thickness = 0.15`.
+    #[serde(default)]
+    pub doors: std::collections::BTreeMap<String, DoorFile>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct DoorFile {
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    pub thickness: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]

@@ -6,11 +6,13 @@
 pub mod error;
 pub mod file;
 pub mod localizers;
+pub mod navigation;
 pub mod resolve;
 
 pub use error::ScenarioError;
 pub use file::SensorName;
 pub use localizers::{LocalizerConfig, LocalizerKind};
+pub use navigation::NavConfig;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -35,6 +37,18 @@ pub struct Scenario {
     pub record: RecordConfig,
     pub robots: Vec<RobotConfig>,
     pub events: Vec<Event>,
+    /// Doors of the map (from the places file), all open at the start.
+    pub doors: Vec<DoorConfig>,
+    /// End the run as soon as every robot with tasks has done them all.
+    pub end_when_done: bool,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct DoorConfig {
+    pub name: String,
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    pub thickness: f64,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -75,12 +89,15 @@ pub struct RobotConfig {
     pub laser: Option<LaserSpec>,
     pub encoder: Option<EncoderSpec>,
     pub localizers: Vec<LocalizerConfig>,
+    /// Task-driven navigation (planner, follower, task queue), if the robot has tasks.
+    pub navigation: Option<NavConfig>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Event {
     pub at: f64,
-    pub robot: String,
+    /// The robot concerned (None for world events such as doors).
+    pub robot: Option<String>,
     pub action: EventAction,
 }
 
@@ -94,6 +111,11 @@ pub enum EventAction {
     SensorFault {
         sensor: SensorName,
         active: bool,
+    },
+    /// Door number `index` of [`Scenario::doors`] opens or closes.
+    Door {
+        index: usize,
+        open: bool,
     },
 }
 

@@ -3,7 +3,7 @@
 
 use super::error::{ErrorContext, KeyPath, ScenarioError};
 use super::file::*;
-use super::{Event, EventAction, RecordConfig, RobotConfig, Scenario};
+use super::{DoorConfig, Event, EventAction, RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};
@@ -171,6 +171,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
     }
 
     let mut places = BTreeMap::new();
+    let mut doors = Vec::new();
     if let Some(pf) = &map.places {
         let ppath = base_dir.join(pf);
         let ptext = std::fs::read_to_string(&ppath).map_err(|e| {
@@ -190,6 +191,36 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
                 name,
                 Pose2::new(place.pose[0], place.pose[1], place.pose[2]),
             );
+        }
+        for (name, d) in parsed.doors {
+            let dp = KeyPath::default().key("doors").key(&name);
+            let b = grid.bounds();
+            for (key, v) in [("from", d.from), ("to", d.to)] {
+                if v.iter().any(|x| !x.is_finite())
+                    || v[0] < b[0]
+                    || v[1] < b[1]
+                    || v[0] > b[2]
+                    || v[1] > b[3]
+                {
+                    return Err(pcx.at(
+                        &dp.key(key),
+                        format!("expected a finite [x, y] inside the map, got {v:?}"),
+                    ));
+                }
+            }
+            let thickness = d.thickness.unwrap_or(0.15);
+            if !(thickness > 0.0 && thickness <= 2.0) {
+                return Err(pcx.at(
+                    &dp.key("thickness"),
+                    format!("expected a number in (0, 2] m, got {thickness}"),
+                ));
+            }
+            doors.push(DoorConfig {
+                name,
+                from: d.from,
+                to: d.to,
+                thickness,
+            });
         }
     }
 
@@ -360,6 +391,48 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
                  `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
             );
         }
+        let navigation = super::navigation::resolve_navigation(
+            &c,
+            &p,
+            r.navigation.as_ref(),
+            &r.tasks,
+            super::navigation::RobotParts {
+                kinematics: &kinematics,
+                footprint: &footprint,
+                localizers: &localizers,
+                index: i,
+            },
+            &|path: &KeyPath, v: &PointOrPlace| {
+                let pose = point(path, v)?;
+                inside(path, &pose)?;
+                if !grid.disc_is_clear(pose.x, pose.y, footprint.bounding_radius()) {
+                    return c.err(
+                        path,
+                        format!(
+                            "the goal ({:.2}, {:.2}) is too close to an obstacle for the robot (radius {:.2} m)",
+                            pose.x,
+                            pose.y,
+                            footprint.bounding_radius()
+                        ),
+                    );
+                }
+                Ok(pose)
+            },
+        )?;
+        if navigation.is_some() {
+            if r.behaviour.is_some() {
+                return c.err(
+                    &bp,
+                    "a robot with tasks is driven by its navigator: remove `behaviour`",
+                );
+            }
+            if encoder.is_none() {
+                return c.err(
+                    &p.key("tasks"),
+                    "a robot with tasks navigates by its odometry and localization: give it `[robots.sensors.encoder]`",
+                );
+            }
+        }
         if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
             return c.err(
                 &bp.key("type"),
@@ -377,6 +450,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             laser,
             encoder,
             localizers,
+            navigation,
         });
     }
 
@@ -385,8 +459,66 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
     for (i, e) in f.events.iter().enumerate() {
         let p = root.key("events").index(i);
         let at = c.range(&p.key("at"), e.at, Some(0.0), Some(duration), false)?;
-        let Some(robot) = robots.iter().find(|r| r.name == e.robot) else {
-            return c.err(&p.key("robot"), format!("no robot named `{}`", e.robot));
+        if e.kind == EventType::Door {
+            if e.robot.is_some() {
+                return c.err(
+                    &p.key("robot"),
+                    "a door event concerns no robot: remove `robot`",
+                );
+            }
+            for (key, present) in [
+                ("points", e.points.is_some()),
+                ("loop", e.looping.is_some()),
+                ("pose", e.pose.is_some()),
+                ("sensor", e.sensor.is_some()),
+                ("active", e.active.is_some()),
+            ] {
+                if present {
+                    return c.err(
+                        &p.key(key),
+                        format!("`{key}` does not apply to a `door` event"),
+                    );
+                }
+            }
+            let Some(door) = &e.door else {
+                return c.err(
+                    &p,
+                    "a door event needs `door` (a door of the map's places file)",
+                );
+            };
+            let Some(index) = doors.iter().position(|d| &d.name == door) else {
+                let known: Vec<&str> = doors.iter().map(|d| d.name.as_str()).collect();
+                return c.err(
+                    &p.key("door"),
+                    if known.is_empty() {
+                        format!("unknown door `{door}` (the map's places file defines no doors)")
+                    } else {
+                        format!("unknown door `{door}`; known doors: {}", known.join(", "))
+                    },
+                );
+            };
+            let Some(open) = e.open else {
+                return c.err(&p, "a door event needs `open` (true or false)");
+            };
+            events.push(Event {
+                at,
+                robot: None,
+                action: EventAction::Door { index, open },
+            });
+            continue;
+        }
+        if e.door.is_some() || e.open.is_some() {
+            let key = if e.door.is_some() { "door" } else { "open" };
+            return c.err(
+                &p.key(key),
+                format!("`{key}` applies to `door` events only"),
+            );
+        }
+        let Some(robot_name) = &e.robot else {
+            return c.err(&p, "missing key `robot` (the robot the event concerns)");
+        };
+        let Some(robot) = robots.iter().find(|r| &r.name == robot_name) else {
+            return c.err(&p.key("robot"), format!("no robot named `{robot_name}`"));
         };
         let only = |key: &str, present: bool, kind: &str| -> R<()> {
             if present {
@@ -398,7 +530,17 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             Ok(())
         };
         let action = match e.kind {
+            EventType::Door => continue, // resolved above
             EventType::Waypoints => {
+                if robot.navigation.is_some() {
+                    return c.err(
+                        &p.key("robot"),
+                        format!(
+                            "robot `{}` is driven by its tasks; a route event cannot apply",
+                            robot.name
+                        ),
+                    );
+                }
                 only("pose", e.pose.is_some(), "waypoints")?;
                 only("sensor", e.sensor.is_some(), "waypoints")?;
                 only("active", e.active.is_some(), "waypoints")?;
@@ -469,6 +611,8 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         record,
         robots,
         events,
+        doors,
+        end_when_done: f.end_when_done.unwrap_or(false),
     })
 }
 

@@ -1,11 +1,13 @@
 //! Evaluation against ground truth: per-robot distance, collisions and odometry drift, and the
-//! accuracy of every localizer (ATE, RPE, convergence, tracking).
+//! accuracy of every localizer (ATE, RPE, convergence, tracking), and navigation outcomes.
 
 pub mod localization_metrics;
+pub mod navigation_metrics;
 pub mod robot_metrics;
 pub mod trajectory;
 
 pub use localization_metrics::{LocalizationSamples, LocalizerMetrics, judged_samples};
+pub use navigation_metrics::NavOutcome;
 pub use robot_metrics::RobotMetrics;
 pub use trajectory::Sample;
 
@@ -20,6 +22,7 @@ impl SimPlugin for EvalPlugin {
             (
                 robot_metrics::accumulate_metrics,
                 localization_metrics::sample_localization,
+                navigation_metrics::evaluate_navigation.after(robot_metrics::accumulate_metrics),
             )
                 .in_set(SimSet::Evaluate),
         );

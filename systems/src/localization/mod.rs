@@ -13,6 +13,7 @@ pub mod map;
 pub mod markov_grid;
 pub mod mcl;
 pub mod motion_model;
+pub mod nav_source;
 pub mod odometry;
 
 #[cfg(test)]
@@ -25,6 +26,7 @@ pub use map::LocalizationMap;
 pub use markov_grid::{MarkovGrid, MarkovGridConfig};
 pub use mcl::{Mcl, MclConfig, PoseEstimate};
 pub use motion_model::OdometryMotionModel;
+pub use nav_source::NavSource;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};
 
 use crate::core::{SimPlugin, SimSet};
@@ -35,7 +37,11 @@ pub struct LocalizationPlugin;
 impl SimPlugin for LocalizationPlugin {
     fn build(&self, _world: &mut World, schedule: &mut Schedule) {
         schedule.add_systems(
-            (odometry::integrate_odometry, localizer::run_localizers)
+            (
+                odometry::integrate_odometry,
+                localizer::run_localizers,
+                nav_source::fuse_nav_belief,
+            )
                 .chain()
                 .in_set(SimSet::Estimate),
         );

@@ -1,18 +1,38 @@
-//! Driving behaviours (Control set). For now: waypoint following and a laser-based wander, both
-//! with reactive obstacle avoidance on the latest scan. They read the robot's belief
+//! Navigation (Plan and Control sets). Everything here reads the robot's belief
 //! ([`NavBelief`](crate::localization::NavBelief)) and its sensor readings, never ground truth.
-//! Global planning: the static [`costmap`] and A* on it.
+//!
+//! - [`costmap`]: the static map inflated by the robot radius plus a margin, with a cost
+//!   gradient near walls ([`shared_costmaps`]: one per inflation setting, rebuilt when a door
+//!   moves);
+//! - [`astar`]: the global planner, with [`shortcut`] line-of-sight shortening;
+//! - [`follower`]: pure pursuit for differential-drive and Ackermann robots;
+//! - [`navigator`]: task queues (deliveries, trips, waits: [`tasks`]), stop-and-wait at
+//!   obstacles, re-planning, and the yield rule between robots ([`fleet`]); [`drive`] holds its
+//!   systems;
+//! - [`behaviour`]: simple behaviours without a planner (waypoints, wander) with reactive
+//!   avoidance ([`avoid`]).
 
 pub mod astar;
 pub mod avoid;
 pub mod behaviour;
 pub mod costmap;
+pub mod drive;
+pub mod fleet;
+pub mod follower;
+pub mod navigator;
 pub mod open_list;
+pub mod shared_costmaps;
 pub mod shortcut;
+pub mod tasks;
 
 pub use astar::{Path, PlanError, Planner, PlannerParams};
 pub use behaviour::{Behaviour, BehaviourKind, NavStatus};
 pub use costmap::{Costmap, CostmapParams};
+pub use fleet::Fleet;
+pub use follower::{FollowerParams, Steering};
+pub use navigator::{LegEvent, NavEvent, NavFailure, NavMetrics, NavParams, Navigator, Phase};
+pub use shared_costmaps::NavCostmaps;
+pub use tasks::{Goal, Step, Task, TaskKind};
 
 use crate::core::{SimPlugin, SimSet};
 use bevy_ecs::prelude::*;
@@ -20,7 +40,15 @@ use bevy_ecs::prelude::*;
 pub struct NavigationPlugin;
 
 impl SimPlugin for NavigationPlugin {
-    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
-        schedule.add_systems(behaviour::drive_behaviours.in_set(SimSet::Control));
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        world.init_resource::<Fleet>();
+        schedule.add_systems(
+            (shared_costmaps::sync_costmaps, drive::plan_routes)
+                .chain()
+                .in_set(SimSet::Plan),
+        );
+        schedule.add_systems(
+            (behaviour::drive_behaviours, drive::drive_navigators).in_set(SimSet::Control),
+        );
     }
 }

@@ -4,6 +4,7 @@
 //! distance field localization weighs scans on lives here too.
 
 pub mod distance_field;
+pub mod doors;
 pub mod grid;
 pub mod map_file;
 pub mod rects;
@@ -11,6 +12,7 @@ pub mod shapes;
 pub mod static_world;
 
 pub use distance_field::DistanceField;
+pub use doors::{Door, Doors};
 pub use grid::{Cell, OccupancyGrid};
 pub use map_file::{MapError, load_map};
 pub use shapes::Shape;

@@ -5,6 +5,7 @@ mod common;
 mod determinism;
 mod events;
 mod localization;
+mod navigation;
 mod physics;
 mod recording;
 mod scenarios;

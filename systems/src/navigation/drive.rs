@@ -1,0 +1,96 @@
+//! The navigation systems: plans in the Plan set, the navigators' state machines in the Control
+//! set. Both run the robots in parallel on the kernel pool; each navigator touches only its own
+//! state and reads shared data (costmaps, the fleet board published before the parallel part),
+//! so the thread count never changes a result.
+
+use super::avoid::SectorRanges;
+use super::fleet::Fleet;
+use super::navigator::{ControlContext, Navigator};
+use super::shared_costmaps::NavCostmaps;
+use crate::body::DriveCommand;
+use crate::core::{KernelPool, RobotIndex, SimClock};
+use crate::localization::NavBelief;
+use crate::sensors::{Laser, LaserScans};
+use bevy_ecs::prelude::*;
+use rayon::prelude::*;
+
+/// Plan: answer every pending plan request from the robot's belief.
+pub fn plan_routes(
+    clock: Res<SimClock>,
+    pool: Res<KernelPool>,
+    costmaps: Option<Res<NavCostmaps>>,
+    mut robots: Query<(&mut Navigator, &NavBelief)>,
+) {
+    let Some(costmaps) = costmaps else {
+        return;
+    };
+    let now = clock.start();
+    let mut jobs: Vec<_> = robots
+        .iter_mut()
+        .filter(|(n, _)| n.request.is_some())
+        .collect();
+    if jobs.is_empty() {
+        return;
+    }
+    let costmaps = &*costmaps;
+    pool.install(|| {
+        jobs.par_iter_mut().for_each(|(nav, belief)| {
+            let map = costmaps.get(nav.params.costmap);
+            nav.plan(now, map, &belief.pose);
+        });
+    });
+}
+
+/// Control: publish the fleet board, then run every navigator.
+#[allow(clippy::type_complexity)]
+pub fn drive_navigators(
+    clock: Res<SimClock>,
+    pool: Res<KernelPool>,
+    costmaps: Option<Res<NavCostmaps>>,
+    mut fleet: ResMut<Fleet>,
+    mut robots: Query<(
+        &RobotIndex,
+        &mut Navigator,
+        &NavBelief,
+        &mut DriveCommand,
+        Option<(&Laser, &LaserScans)>,
+    )>,
+) {
+    let Some(costmaps) = costmaps else {
+        return;
+    };
+    // the board: every navigator's state at the start of this tick
+    let n = robots
+        .iter()
+        .map(|(i, ..)| i.0 as usize + 1)
+        .max()
+        .unwrap_or(0);
+    fleet.entries.clear();
+    fleet.entries.resize(n, None);
+    for (idx, nav, belief, _, _) in robots.iter() {
+        fleet.entries[idx.0 as usize] = Some(nav.fleet_entry(idx.0, &belief.pose));
+    }
+    let fleet = &*fleet;
+    let (now, dt) = (clock.start(), clock.dt);
+    let costmaps = &*costmaps;
+    let mut jobs: Vec<_> = robots.iter_mut().collect();
+    pool.install(|| {
+        jobs.par_iter_mut()
+            .for_each(|(idx, nav, belief, cmd, laser)| {
+                if let Some((laser, scans)) = laser {
+                    if let Some(scan) = scans.scans.last() {
+                        nav.seen = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+                    } else if !laser.enabled {
+                        nav.seen = None;
+                    }
+                }
+                let ctx = ControlContext {
+                    now,
+                    dt,
+                    costmap: costmaps.get(nav.params.costmap),
+                    costmap_version: costmaps.version,
+                };
+                **cmd = nav.control(&ctx, idx.0, &belief.pose, fleet);
+            });
+    });
+}

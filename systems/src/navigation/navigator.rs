@@ -1,0 +1,818 @@
+//! The navigator: a robot's task queue executed on its own belief (the localization estimate it
+//! navigates by), never ground truth. Per tick, in the Control set, it advances a small state
+//! machine:
+//!
+//! - `Driving`: pure pursuit ([`super::follower`]) along the planned path, slowed by the free
+//!   space the laser and sonars see ahead; an obstacle closer than `stop_distance` (gap from the
+//!   robot's outline) stops it (`Blocked`).
+//! - `Blocked`: stand still; go on as soon as the way is clear. Another robot coming the other
+//!   way is settled by the yield rule ([`super::fleet`]). Otherwise, after `wait_time` seconds
+//!   the robot asks for a plan around what it sees (laser points in free space marked on a copy
+//!   of the costmap, [`mark_obstacles`]) and retries every `wait_time` while none exists. A robot
+//!   parked at our goal is waited for.
+//! - `Yielding`: driving to a spot off the other robot's path, then waiting there until it has
+//!   passed; then re-plan to the goal.
+//! - `Waiting` at a place (loading, unloading) for the task's time.
+//!
+//! Plans are computed in the Plan set from the requests the state machine leaves
+//! ([`PlanRequest`]); a goal the static costmap cannot reach fails the task with the planner's
+//! reason instead of retrying forever. A door closing across the current path (the shared
+//! costmap changes) triggers a re-plan.
+
+use super::astar::{PlanError, Planner, PlannerParams};
+use super::avoid::SectorRanges;
+use super::costmap::{Costmap, INSCRIBED, LETHAL};
+use super::fleet::{Fleet, FleetActivity, FleetEntry, comes_through, gives_way, yield_spot};
+use super::follower::{FollowerParams, FollowerState, Steering, follow};
+use super::tasks::{Goal, Step, Task};
+use crate::body::DriveCommand;
+use crate::core::Pose2;
+use bevy_ecs::prelude::*;
+
+/// Navigation settings of one robot.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavParams {
+    pub follower: FollowerParams,
+    pub steering: Steering,
+    /// Radius of the robot's bounding circle (m).
+    pub radius: f64,
+    /// Stop when something is this close (m) to the robot's outline, in the band it drives
+    /// through.
+    pub stop_distance: f64,
+    /// Seconds to wait at an obstacle before planning around it.
+    pub wait_time: f64,
+    /// Yield priority: the robot with the higher number gives way (ties: the later robot).
+    pub priority: u32,
+    pub planner: PlannerParams,
+    /// Which of the shared costmaps (one per inflation radius) the robot plans on.
+    pub costmap: usize,
+}
+
+impl Default for NavParams {
+    fn default() -> Self {
+        NavParams {
+            follower: FollowerParams::default(),
+            steering: Steering::DiffDrive,
+            radius: 0.3,
+            stop_distance: 0.35,
+            wait_time: 3.0,
+            priority: 0,
+            planner: PlannerParams::default(),
+            costmap: 0,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Phase {
+    /// Nothing (more) to do.
+    Idle,
+    /// A plan has been requested.
+    Planning,
+    Driving,
+    Blocked {
+        since: f64,
+    },
+    Yielding {
+        for_robot: u32,
+        since: f64,
+        parked: bool,
+    },
+    Waiting {
+        until: f64,
+    },
+}
+
+/// What the Plan set should compute.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanRequest {
+    pub goal: [f64; 2],
+    /// Obstacle points (world frame) to plan around; empty for a plan on the shared costmap.
+    pub around: Vec<[f64; 2]>,
+}
+
+/// One failed task.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavFailure {
+    pub time: f64,
+    pub task: String,
+    pub reason: String,
+}
+
+/// Navigation outcomes the robot itself knows (ground-truth ones are in `eval`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NavMetrics {
+    pub tasks_completed: u32,
+    pub tasks_failed: u32,
+    pub deliveries_completed: u32,
+    /// Duration of each completed delivery, from taking the task to the end of unloading (s).
+    pub delivery_times_s: Vec<f64>,
+    /// Stops for obstacles (each stop counted once, however long).
+    pub stops: u32,
+    /// Time spent stopped for obstacles or waiting aside for another robot (s).
+    pub waiting_time_s: f64,
+    pub replans: u32,
+    /// Times the robot stepped aside for another robot.
+    pub yields: u32,
+    pub failures: Vec<NavFailure>,
+}
+
+/// A navigation event for logs and the recording.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NavEvent {
+    pub time: f64,
+    pub text: String,
+}
+
+/// A leg (one `Go` step) starting or ending, for the ground-truth evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LegEvent {
+    Started { goal: [f64; 2] },
+    Finished { goal: [f64; 2], reached: bool },
+}
+
+#[derive(Component, Clone, Debug)]
+pub struct Navigator {
+    pub params: NavParams,
+    pub tasks: Vec<Task>,
+    /// Index of the current task (== tasks.len() when all are done).
+    pub task: usize,
+    steps: Vec<Step>,
+    step: usize,
+    pub phase: Phase,
+    pub goal: Option<Goal>,
+    /// The path being followed (world points), and a counter bumped whenever it changes.
+    pub path: Vec<[f64; 2]>,
+    pub path_serial: u64,
+    follower: FollowerState,
+    pub request: Option<PlanRequest>,
+    pub metrics: NavMetrics,
+    /// Every event so far (the recorder logs the new ones).
+    pub events: Vec<NavEvent>,
+    /// Legs started or finished during this tick.
+    pub legs: Vec<LegEvent>,
+    pub(crate) planner: Planner,
+    task_started: f64,
+    cannot_yield: bool,
+    costmap_version: u64,
+    /// Obstacle points seen ahead (base frame), refreshed from the sensors.
+    pub(crate) seen: Option<SectorRanges>,
+    /// Extra obstacle points in the base frame (sonar echoes), refreshed every tick.
+    pub(crate) extra: Vec<(f32, f32)>,
+}
+
+impl Navigator {
+    pub fn new(params: NavParams, tasks: Vec<Task>) -> Self {
+        let planner = Planner::new(params.planner);
+        Navigator {
+            params,
+            tasks,
+            task: 0,
+            steps: Vec::new(),
+            step: 0,
+            phase: Phase::Idle,
+            goal: None,
+            path: Vec::new(),
+            path_serial: 0,
+            follower: FollowerState::default(),
+            request: None,
+            metrics: NavMetrics::default(),
+            events: Vec::new(),
+            legs: Vec::new(),
+            planner,
+            task_started: 0.0,
+            cannot_yield: false,
+            costmap_version: 0,
+            seen: None,
+            extra: Vec::new(),
+        }
+    }
+
+    /// True when every task has been done (or has failed).
+    pub fn finished(&self) -> bool {
+        self.task >= self.tasks.len() && self.phase == Phase::Idle
+    }
+
+    /// The current task's description, for the recording.
+    pub fn status_text(&self) -> String {
+        let Some(task) = self.tasks.get(self.task) else {
+            return format!(
+                "all tasks done ({} completed, {} failed)",
+                self.metrics.tasks_completed, self.metrics.tasks_failed
+            );
+        };
+        let what = match (&self.phase, self.steps.get(self.step)) {
+            (Phase::Waiting { .. }, Some(Step::Wait { label, .. })) => label.to_string(),
+            (Phase::Blocked { .. }, _) => "stopped for an obstacle".into(),
+            (Phase::Yielding { for_robot, .. }, _) => format!("giving way to robot #{for_robot}"),
+            (Phase::Planning, _) => "planning".into(),
+            (_, Some(Step::Go(g))) => format!("driving to {}", g.name),
+            _ => "idle".into(),
+        };
+        format!("{} — {what}", task.describe())
+    }
+
+    fn log(&mut self, time: f64, text: impl Into<String>) {
+        self.events.push(NavEvent {
+            time,
+            text: text.into(),
+        });
+    }
+
+    fn set_path(&mut self, path: Vec<[f64; 2]>) {
+        self.path = path;
+        self.path_serial += 1;
+        self.follower.segment = 0;
+    }
+
+    /// The board entry this robot publishes.
+    pub fn fleet_entry(&self, index: u32, pose: &Pose2) -> FleetEntry {
+        let activity = match self.phase {
+            Phase::Driving | Phase::Blocked { .. } | Phase::Planning => FleetActivity::Driving,
+            Phase::Yielding {
+                for_robot, parked, ..
+            } => FleetActivity::Yielding { for_robot, parked },
+            Phase::Idle | Phase::Waiting { .. } => FleetActivity::Parked,
+        };
+        let mut path_ahead = vec![[pose.x, pose.y]];
+        if matches!(activity, FleetActivity::Driving) && self.path.len() >= 2 {
+            let mut left = 8.0;
+            let mut prev = [pose.x, pose.y];
+            for &p in &self.path[(self.follower.segment + 1).min(self.path.len() - 1)..] {
+                path_ahead.push(p);
+                left -= (p[0] - prev[0]).hypot(p[1] - prev[1]);
+                prev = p;
+                if left <= 0.0 {
+                    break;
+                }
+            }
+        }
+        FleetEntry {
+            index,
+            pose: *pose,
+            radius: self.params.radius,
+            priority: self.params.priority,
+            activity,
+            path_ahead,
+            cannot_yield: self.cannot_yield,
+        }
+    }
+
+    /// Moves on to the next step (starting the next task when the current one is done).
+    fn next_step(&mut self, now: f64) {
+        self.step += 1;
+        if self.step >= self.steps.len() {
+            if let Some(t) = self.tasks.get(self.task)
+                && !self.steps.is_empty()
+            {
+                self.metrics.tasks_completed += 1;
+                if t.is_delivery() {
+                    self.metrics.deliveries_completed += 1;
+                    self.metrics.delivery_times_s.push(now - self.task_started);
+                }
+                let name = t.name.clone();
+                self.log(now, format!("task {name} completed"));
+                self.task += 1;
+            }
+            self.steps.clear();
+            self.step = 0;
+        }
+        self.start_step(now);
+    }
+
+    /// Abandons the current task.
+    fn fail_task(&mut self, now: f64, reason: String) {
+        let name = self
+            .tasks
+            .get(self.task)
+            .map(|t| t.name.clone())
+            .unwrap_or_default();
+        self.log(now, format!("task {name} FAILED: {reason}"));
+        self.metrics.tasks_failed += 1;
+        self.metrics.failures.push(NavFailure {
+            time: now,
+            task: name,
+            reason,
+        });
+        self.task += 1;
+        self.steps.clear();
+        self.step = 0;
+        self.start_step(now);
+    }
+
+    fn start_step(&mut self, now: f64) {
+        if self.steps.is_empty() {
+            let Some(task) = self.tasks.get(self.task) else {
+                self.phase = Phase::Idle;
+                self.goal = None;
+                return;
+            };
+            self.steps = task.steps();
+            self.step = 0;
+            self.task_started = now;
+            let d = task.describe();
+            self.log(now, format!("task started: {d}"));
+        }
+        match self.steps[self.step].clone() {
+            Step::Go(goal) => {
+                self.request = Some(PlanRequest {
+                    goal: [goal.pose.x, goal.pose.y],
+                    around: Vec::new(),
+                });
+                self.legs.push(LegEvent::Started {
+                    goal: [goal.pose.x, goal.pose.y],
+                });
+                self.goal = Some(goal);
+                self.phase = Phase::Planning;
+            }
+            Step::Wait { seconds, label } => {
+                self.phase = Phase::Waiting {
+                    until: now + seconds,
+                };
+                self.log(now, format!("{label} for {seconds:.0} s"));
+            }
+        }
+    }
+
+    /// Plan set: answers the pending request on `map` (the shared costmap, or a copy with the
+    /// request's obstacles marked).
+    pub fn plan(&mut self, now: f64, map: &Costmap, from: &Pose2) {
+        let Some(req) = self.request.take() else {
+            return;
+        };
+        let around = !req.around.is_empty();
+        let marked;
+        let map = if around {
+            // keep the stop band (radius + 5 cm) and a margin off what was seen, so the new
+            // path does not stop the robot again at once
+            let keep_off = self.params.radius + 0.15;
+            marked = mark_obstacles(map, &req.around, keep_off, [from.x, from.y]);
+            &marked
+        } else {
+            map
+        };
+        let mut result = self.planner.plan(map, [from.x, from.y], req.goal);
+        if let Err(PlanError::StartBlocked { .. }) = result
+            && let Some(free) = nearest_free(map, [from.x, from.y], 0.5)
+        {
+            // squeezed against something (a doorway, a passing bay): plan from the nearest cell
+            // the robot may occupy, and get there first
+            result = self.planner.plan(map, free, req.goal).map(|mut p| {
+                p.waypoints.insert(0, [from.x, from.y]);
+                p
+            });
+        }
+        match result {
+            Ok(p) => {
+                self.set_path(p.waypoints);
+                if matches!(self.phase, Phase::Planning | Phase::Blocked { .. }) {
+                    self.phase = Phase::Driving;
+                }
+            }
+            Err(e) if around => {
+                // nothing around the obstacle: keep waiting, try again later
+                self.log(now, format!("no way around the obstacle yet: {e}"));
+                if let Phase::Blocked { since } = &mut self.phase {
+                    *since = now;
+                }
+            }
+            Err(e) => {
+                let goal = req.goal;
+                self.legs.push(LegEvent::Finished {
+                    goal,
+                    reached: false,
+                });
+                let reason = match &e {
+                    PlanError::Unreachable { .. } => format!("goal unreachable: {e}"),
+                    _ => e.to_string(),
+                };
+                self.fail_task(now, reason);
+            }
+        }
+    }
+
+    /// Control set: one tick of the state machine; returns the drive command.
+    pub fn control(
+        &mut self,
+        ctx: &ControlContext,
+        index: u32,
+        pose: &Pose2,
+        fleet: &Fleet,
+    ) -> DriveCommand {
+        let now = ctx.now;
+        if self.phase == Phase::Idle && self.task < self.tasks.len() {
+            self.start_step(now);
+        }
+        // the shared costmap changed (a door): re-plan if the path now crosses an obstacle
+        if ctx.costmap_version != self.costmap_version {
+            self.costmap_version = ctx.costmap_version;
+            if matches!(self.phase, Phase::Driving | Phase::Blocked { .. })
+                && path_blocked(ctx.costmap, &self.path, self.follower.segment)
+            {
+                self.replan_to_goal(now, "map changed across the path: re-planning");
+            }
+        }
+        let p = self.params.clone();
+        let gap = self.gap_ahead(pose, ctx.costmap);
+        match self.phase {
+            Phase::Idle | Phase::Planning => self.brake(ctx.dt),
+            Phase::Waiting { until } => {
+                if now + 1e-9 >= until {
+                    self.next_step(now);
+                }
+                self.brake(ctx.dt)
+            }
+            Phase::Driving | Phase::Yielding { parked: false, .. } => {
+                if self.path.is_empty() {
+                    return self.brake(ctx.dt);
+                }
+                // slow down in front of obstacles: stop `stop_distance` short of them
+                let room = gap - p.stop_distance;
+                let cap = if room <= 0.0 {
+                    0.0
+                } else {
+                    (2.0 * p.follower.max_accel * room).sqrt()
+                };
+                // stepping aside is a slow, tight manoeuvre (short look-ahead: no corner cutting
+                // at the mouth of a bay)
+                let mut fp = p.follower;
+                if matches!(self.phase, Phase::Yielding { .. }) {
+                    fp.speed = fp.speed.min(0.3);
+                    fp.lookahead = 0.2;
+                    fp.lookahead_time = 0.0;
+                }
+                let out = follow(
+                    &self.path,
+                    pose,
+                    &mut self.follower,
+                    &fp,
+                    &p.steering,
+                    cap,
+                    ctx.dt,
+                );
+                if out.arrived {
+                    if let Phase::Yielding { for_robot, .. } = self.phase {
+                        self.phase = Phase::Yielding {
+                            for_robot,
+                            since: now,
+                            parked: true,
+                        };
+                    } else {
+                        if let Some(g) = &self.goal {
+                            let goal = [g.pose.x, g.pose.y];
+                            let name = g.name.clone();
+                            self.legs.push(LegEvent::Finished {
+                                goal,
+                                reached: true,
+                            });
+                            self.log(now, format!("reached {name}"));
+                        }
+                        self.next_step(now);
+                    }
+                    return DriveCommand { v: out.v, w: out.w };
+                }
+                if room <= 0.0 && out.v <= 1e-3 && out.w.abs() < 0.3 && self.wants_forward(pose) {
+                    self.metrics.stops += 1;
+                    self.log(
+                        now,
+                        format!(
+                            "stop at ({:.2}, {:.2}): obstacle {gap:.2} m ahead",
+                            pose.x, pose.y
+                        ),
+                    );
+                    if matches!(self.phase, Phase::Driving) {
+                        self.phase = Phase::Blocked { since: now };
+                    }
+                }
+                if out.off_path > 1.5
+                    && matches!(self.phase, Phase::Driving)
+                    && let Some(g) = &self.goal
+                {
+                    self.metrics.replans += 1;
+                    self.request = Some(PlanRequest {
+                        goal: [g.pose.x, g.pose.y],
+                        around: Vec::new(),
+                    });
+                    self.phase = Phase::Planning;
+                    self.log(now, "off the path: re-planning");
+                }
+                DriveCommand { v: out.v, w: out.w }
+            }
+            Phase::Blocked { since } => {
+                self.metrics.waiting_time_s += ctx.dt;
+                if gap - p.stop_distance > 0.1 {
+                    self.phase = Phase::Driving;
+                    self.log(now, "way clear: going on");
+                    return self.brake(ctx.dt);
+                }
+                self.settle_block(ctx, index, pose, fleet, since);
+                self.brake(ctx.dt)
+            }
+            Phase::Yielding {
+                for_robot,
+                since,
+                parked: true,
+            } => {
+                self.metrics.waiting_time_s += ctx.dt;
+                let me = self.fleet_entry(index, pose);
+                let still_coming = fleet.get(for_robot).is_some_and(|o| {
+                    comes_through(o, &me, o.radius + me.radius + 0.2)
+                        || (o.pose.x - pose.x).hypot(o.pose.y - pose.y) < o.radius + me.radius + 0.3
+                });
+                if !still_coming || now - since > 60.0 {
+                    self.replan_to_goal(now, "gave way: re-planning to the goal");
+                }
+                self.brake(ctx.dt)
+            }
+        }
+    }
+
+    fn replan_to_goal(&mut self, now: f64, why: &str) {
+        if let Some(g) = &self.goal {
+            self.request = Some(PlanRequest {
+                goal: [g.pose.x, g.pose.y],
+                around: Vec::new(),
+            });
+            self.metrics.replans += 1;
+            self.phase = Phase::Planning;
+            self.log(now, why);
+        } else {
+            self.phase = Phase::Idle;
+        }
+    }
+
+    /// A blocked robot decides: give way, wait, or plan around.
+    fn settle_block(
+        &mut self,
+        ctx: &ControlContext,
+        index: u32,
+        pose: &Pose2,
+        fleet: &Fleet,
+        since: f64,
+    ) {
+        let now = ctx.now;
+        let p = &self.params;
+        let me = self.fleet_entry(index, pose);
+        let reach = p.stop_distance + p.radius + 0.6;
+        if let Some(other) = fleet.robot_ahead(&me, p.radius + 0.05, reach) {
+            let clearance = me.radius + other.radius + 0.1;
+            let oncoming = comes_through(other, &me, clearance);
+            if matches!(other.activity, FleetActivity::Yielding { for_robot, parked: false } if for_robot == index)
+            {
+                return; // it is making room for us (once it is aside, plan around it if need be)
+            }
+            if oncoming {
+                if gives_way(&me, other) && now - since >= 0.5 {
+                    let keep_clear = other.path_ahead.clone();
+                    // a spot well out of the way if there is one (deeper into a bay), else
+                    // one just clear of the other robot's band
+                    let spot = |extra: f64| {
+                        yield_spot(
+                            ctx.costmap,
+                            [pose.x, pose.y],
+                            [other.pose.x, other.pose.y],
+                            me.radius + other.radius,
+                            &keep_clear,
+                            clearance + extra,
+                            15.0,
+                        )
+                    };
+                    match spot(0.35).or_else(|| spot(0.05)) {
+                        Some(path) => {
+                            let o = other.index;
+                            self.set_path(path);
+                            self.metrics.yields += 1;
+                            self.cannot_yield = false;
+                            self.phase = Phase::Yielding {
+                                for_robot: o,
+                                since: now,
+                                parked: false,
+                            };
+                            self.log(now, format!("giving way to robot #{o}"));
+                        }
+                        None => {
+                            if !self.cannot_yield {
+                                self.log(now, "nowhere to give way");
+                            }
+                            self.cannot_yield = true;
+                        }
+                    }
+                }
+                if !(self.cannot_yield && now - since >= self.params.wait_time) {
+                    return; // wait for the other robot to give way
+                }
+            } else if let Some(g) = &self.goal {
+                let at_goal = (other.pose.x - g.pose.x).hypot(other.pose.y - g.pose.y)
+                    < other.radius + me.radius + 0.3;
+                if at_goal && other.activity == FleetActivity::Parked {
+                    return; // it is using our goal: wait until it leaves
+                }
+            }
+        }
+        if now - since >= self.params.wait_time
+            && let Some(g) = &self.goal
+        {
+            let around = self.obstacles_world(pose);
+            let goal = [g.pose.x, g.pose.y];
+            self.request = Some(PlanRequest { goal, around });
+            self.metrics.replans += 1;
+            self.phase = Phase::Blocked { since: now };
+            self.log(now, "still blocked: planning around the obstacle");
+        }
+    }
+
+    /// Free distance (m) from the robot's outline to the nearest seen obstacle in the band it will
+    /// sweep: along the path ahead when there is one (so walls beside a doorway the path threads
+    /// do not count), straight ahead otherwise.
+    fn gap_ahead(&self, pose: &Pose2, map: &Costmap) -> f64 {
+        let r = self.params.radius;
+        let hw = r + 0.05;
+        let pts = self
+            .seen
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .chain(self.extra.iter());
+        if self.path.len() < 2 {
+            let mut free = f64::INFINITY;
+            for &(x, y) in pts {
+                if x > 0.0 && (y as f64).abs() < hw {
+                    free = free.min(x as f64);
+                }
+            }
+            return free - r;
+        }
+        // the band: the robot's position, then the path from the segment it is on, for as far as
+        // stopping needs (plus a metre of look-ahead)
+        let v = self.follower.v.max(0.0);
+        let reach =
+            r + self.params.stop_distance + v * v / (2.0 * self.params.follower.max_accel) + 1.0;
+        let mut band = vec![[pose.x, pose.y]];
+        let mut len = 0.0;
+        for &q in &self.path[(self.follower.segment + 1).min(self.path.len() - 1)..] {
+            let last = band[band.len() - 1];
+            len += (q[0] - last[0]).hypot(q[1] - last[1]);
+            band.push(q);
+            if len > reach {
+                break;
+            }
+        }
+        let mut free = f64::INFINITY;
+        for &(x, y) in pts {
+            let w = pose.transform_point([x as f64, y as f64]);
+            // a point on a wall the map knows (within the inscribed radius of it) is not an
+            // obstacle to stop for: the plan already keeps clear of walls
+            let known_wall = map
+                .cell_of(w[0], w[1])
+                .is_none_or(|(c, r)| map.cost(c, r) >= INSCRIBED);
+            if known_wall {
+                continue;
+            }
+            if let Some(along) = along_band(&band, w, hw) {
+                free = free.min(along);
+            }
+        }
+        free - r
+    }
+
+    /// True if the path leads forward from here (not a turn on the spot).
+    fn wants_forward(&self, pose: &Pose2) -> bool {
+        let i = (self.follower.segment + 1).min(self.path.len().saturating_sub(1));
+        self.path.get(i).is_some_and(|&q| {
+            super::follower::bearing_to(pose, q).abs() < self.params.follower.rotate_threshold
+        })
+    }
+
+    /// Seen obstacle points within 4 m, in the world frame of the belief.
+    fn obstacles_world(&self, pose: &Pose2) -> Vec<[f64; 2]> {
+        let mut out = Vec::new();
+        let pts = self
+            .seen
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .chain(self.extra.iter());
+        for &(x, y) in pts {
+            let (x, y) = (x as f64, y as f64);
+            if x * x + y * y <= 16.0 {
+                out.push(pose.transform_point([x, y]));
+            }
+        }
+        out
+    }
+
+    fn brake(&mut self, dt: f64) -> DriveCommand {
+        let a = self.params.follower.max_decel * dt;
+        let aw = self.params.follower.max_yaw_accel * dt;
+        self.follower.v -= self.follower.v.clamp(-a, a);
+        self.follower.w -= self.follower.w.clamp(-aw, aw);
+        DriveCommand {
+            v: self.follower.v,
+            w: self.follower.w,
+        }
+    }
+}
+
+/// Arc length along `band` (a polyline) of the projection of `p`, if `p` lies within
+/// `half_width` of it (ahead of its start).
+fn along_band(band: &[[f64; 2]], p: [f64; 2], half_width: f64) -> Option<f64> {
+    let mut walked = 0.0;
+    let mut best: Option<f64> = None;
+    for w in band.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = dx.hypot(dy);
+        if len > 1e-9 {
+            let t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len;
+            let lateral = ((p[0] - a[0]) * dy - (p[1] - a[1]) * dx).abs() / len;
+            if t > 0.0 && t <= len && lateral < half_width {
+                let at = walked + t;
+                best = Some(best.map_or(at, |b: f64| b.min(at)));
+            }
+        }
+        walked += len;
+    }
+    best
+}
+
+/// Shared inputs of one control tick.
+pub struct ControlContext<'a> {
+    pub now: f64,
+    pub dt: f64,
+    pub costmap: &'a Costmap,
+    pub costmap_version: u64,
+}
+
+/// The centre of the nearest cell within `max_dist` of `p` that the robot may occupy.
+fn nearest_free(map: &Costmap, p: [f64; 2], max_dist: f64) -> Option<[f64; 2]> {
+    let (c0, r0) = map.cell_of(p[0], p[1])?;
+    let reach = (max_dist / map.resolution).ceil() as i64;
+    let mut best: Option<(i64, [f64; 2])> = None;
+    for dr in -reach..=reach {
+        for dc in -reach..=reach {
+            let d2 = dc * dc + dr * dr;
+            if d2 > reach * reach || best.is_some_and(|(b, _)| b <= d2) {
+                continue;
+            }
+            let (c, r) = (c0 as i64 + dc, r0 as i64 + dr);
+            if c < 0 || r < 0 || c >= map.width as i64 || r >= map.height as i64 {
+                continue;
+            }
+            if map.cost(c as usize, r as usize) < INSCRIBED {
+                best = Some((d2, map.cell_center(c as usize, r as usize)));
+            }
+        }
+    }
+    best.map(|(_, q)| q)
+}
+
+/// True if the path from segment `from` on crosses a cell the robot cannot occupy.
+pub fn path_blocked(map: &Costmap, path: &[[f64; 2]], from: usize) -> bool {
+    let start = from.min(path.len().saturating_sub(1));
+    path.get(start..)
+        .unwrap_or(&[])
+        .windows(2)
+        .any(|w| !super::shortcut::segment_clear(map, w[0], w[1], INSCRIBED - 1))
+}
+
+/// A copy of `map` with every obstacle point in free space (static cost below [`INSCRIBED`])
+/// marked lethal and inflated by `radius` (cells within it become [`INSCRIBED`]), so a plan keeps
+/// clear of what the robot sees. Points within `radius` of `robot` are skipped (the robot's own
+/// cell must stay free to plan from).
+pub fn mark_obstacles(map: &Costmap, points: &[[f64; 2]], radius: f64, robot: [f64; 2]) -> Costmap {
+    let mut out = map.clone();
+    let res = map.resolution;
+    let reach = (radius / res).ceil() as i64;
+    let r2 = (radius / res) * (radius / res);
+    for &p in points {
+        if (p[0] - robot[0]).hypot(p[1] - robot[1]) < radius {
+            continue;
+        }
+        let Some((c, r)) = map.cell_of(p[0], p[1]) else {
+            continue;
+        };
+        if map.cost(c, r) >= INSCRIBED {
+            continue; // a wall the map knows
+        }
+        out.costs[map.index(c, r)] = LETHAL;
+        for dr in -reach..=reach {
+            for dc in -reach..=reach {
+                if (dc * dc + dr * dr) as f64 > r2 {
+                    continue;
+                }
+                let (nc, nr) = (c as i64 + dc, r as i64 + dr);
+                if nc < 0 || nr < 0 || nc >= map.width as i64 || nr >= map.height as i64 {
+                    continue;
+                }
+                let i = map.index(nc as usize, nr as usize);
+                if out.costs[i] < INSCRIBED {
+                    out.costs[i] = INSCRIBED;
+                }
+            }
+        }
+    }
+    // never wall the robot in: its own cell stays as it was
+    if let Some((c, r)) = map.cell_of(robot[0], robot[1]) {
+        let i = map.index(c, r);
+        out.costs[i] = map.costs[i];
+    }
+    out
+}
