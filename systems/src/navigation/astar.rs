@@ -314,7 +314,13 @@ impl Planner {
         let nodes = &mut self.nodes[..];
         let open_list = &mut self.open_list;
         let mut expanded = 0;
-        while let Some(e) = open_list.pop() {
+        // entries whose node has been closed or reached with a lower g since are dropped when their
+        // bucket comes up, before they are heaped
+        let live = |e: &Entry, nodes: &[Node]| {
+            let n = nodes[e.idx as usize];
+            n.tag & CLOSED == 0 && entry_g(e) <= n.g
+        };
+        while let Some(e) = open_list.pop(|e| live(e, nodes)) {
             let i = e.idx as usize;
             let node_g = entry_g(&e);
             let here = nodes[i];

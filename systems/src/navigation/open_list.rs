@@ -5,7 +5,13 @@
 //! f never decreases along a search and a node's f exceeds its parent's by at most a bounded
 //! `spread`, so a ring of buckets covering `spread` holds every entry (a spill list catches
 //! rounding surprises). Pops come out in exactly the order of a single binary heap over the same
-//! keys — the heaps are just a few hundred entries instead of tens of thousands.
+//! keys — the heaps are just a few dozen entries instead of tens of thousands.
+//!
+//! A* pushes a node again whenever it finds a cheaper way there, leaving the old entry behind;
+//! about half the entries end up stale. [`OpenList::pop`] takes a `live` test and drops the
+//! entries that fail it when their bucket becomes the lowest, before they are heaped: almost
+//! every stale entry is superseded by then, so they cost one test each instead of a heap push
+//! and pop (cross-building hospital queries 30 -> 21 ms).
 
 use std::collections::BinaryHeap;
 
@@ -86,7 +92,10 @@ impl OpenList {
         }
     }
 
-    pub fn pop(&mut self) -> Option<Entry> {
+    /// The lowest entry. Entries for which `live` is false when their bucket becomes the lowest
+    /// are dropped; `live` must stay false for an entry once it is (the caller still has to
+    /// skip entries that died after their bucket was heaped).
+    pub fn pop(&mut self, live: impl Fn(&Entry) -> bool) -> Option<Entry> {
         loop {
             if let Some(e) = self.heap.pop() {
                 return Some(e);
@@ -104,7 +113,8 @@ impl OpenList {
             }
             let slot = (self.base % RING as u64) as usize;
             self.pending -= self.ring[slot].len();
-            self.heap.extend(self.ring[slot].drain(..));
+            self.heap
+                .extend(self.ring[slot].drain(..).filter(|e| live(e)));
             if !self.spill.is_empty() {
                 // move spilled entries that now fall inside the ring
                 let spill = std::mem::take(&mut self.spill);
@@ -156,7 +166,7 @@ mod tests {
                 heap.push(e);
             }
             for _ in 0..2 {
-                let (a, b) = (open.pop(), heap.pop());
+                let (a, b) = (open.pop(|_| true), heap.pop());
                 assert_eq!(a, b, "after {popped} pops");
                 if let Some(e) = a {
                     f_min = f32::from_bits((e.key >> 32) as u32);
@@ -165,8 +175,58 @@ mod tests {
             }
         }
         while let Some(b) = heap.pop() {
-            assert_eq!(open.pop(), Some(b));
+            assert_eq!(open.pop(|_| true), Some(b));
         }
-        assert_eq!(open.pop(), None);
+        assert_eq!(open.pop(|_| true), None);
+    }
+
+    #[test]
+    fn dropping_dead_entries_keeps_the_order_of_the_live_ones() {
+        let mut state = 11u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as u32
+        };
+        // an entry is dead if its index is a multiple of 3 (a fixed test, as A*'s "closed or
+        // superseded" never comes back to life)
+        let live = |e: &Entry| !e.idx.is_multiple_of(3);
+        let mut open = OpenList::default();
+        open.reset(4.0, 10.0);
+        let mut heap = BinaryHeap::new();
+        let mut f_min = 10.0f32;
+        // the list may hand out dead entries it had already heaped; skip those on both sides
+        let next_live = |open: &mut OpenList, heap: &mut BinaryHeap<Entry>| {
+            let a = std::iter::from_fn(|| open.pop(live)).find(live);
+            let b = std::iter::from_fn(|| heap.pop()).find(live);
+            (a, b)
+        };
+        let mut popped = 0;
+        for _ in 0..3000 {
+            for _ in 0..3 {
+                let f = f_min + (next() % 400) as f32 / 100.0;
+                let e = entry(f, (next() % 50) as f32 / 7.0, next() % 1000);
+                open.push(e);
+                heap.push(e);
+            }
+            for _ in 0..2 {
+                let (a, b) = next_live(&mut open, &mut heap);
+                assert!(a == b, "after {popped} live pops: {a:?} vs {b:?}");
+                if let Some(e) = a {
+                    f_min = f32::from_bits((e.key >> 32) as u32);
+                    popped += 1;
+                }
+            }
+        }
+        loop {
+            let (a, b) = next_live(&mut open, &mut heap);
+            assert!(a == b, "after {popped} live pops: {a:?} vs {b:?}");
+            if a.is_none() {
+                break;
+            }
+            popped += 1;
+        }
+        assert!(popped > 3000, "{popped}");
     }
 }
