@@ -15,8 +15,8 @@
 //!   query always give the same path.
 //! - Scratch lives in [`Planner`] and is reused between queries: a copy of the costmap padded
 //!   with a border of lethal cells (neighbour loops need no bounds tests), per cell g and a tag
-//!   (generation, closed bit, direction to the parent) side by side, and the open list (a binary
-//!   heap over buckets of f, see [`super::open_list`]). The generation in the tag marks which
+//!   (generation, closed bit, direction to the parent) side by side, and the open list (buckets
+//!   of f, see [`super::open_list`]). The generation in the tag marks which
 //!   cells belong to the current query, so no O(cells) clearing happens per query.
 //!
 //! The grid path is then shortened by line of sight ([`super::shortcut`]) into world-frame
