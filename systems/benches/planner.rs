@@ -40,9 +40,10 @@ fn bench_queries(c: &mut Criterion) {
     for (name, a, b) in PAIRS {
         let path = planner.plan(&map, a, b).unwrap();
         eprintln!(
-            "{name}: straight {:.1} m, path {:.1} m, {} waypoints, {} cells expanded",
+            "{name}: straight {:.1} m, path {:.1} m (cost {:.3} m), {} waypoints, {} cells expanded",
             (b[0] - a[0]).hypot(b[1] - a[1]),
             path.length,
+            path.cost,
             path.waypoints.len(),
             path.expanded
         );

@@ -1,11 +1,20 @@
-//! The A* open list: a binary heap split into buckets of f (a two-level bucket queue in the
+//! The A* open list: a priority queue split into buckets of f (a two-level bucket queue in the
 //! spirit of Cherkassky, Goldberg & Radzik, "Shortest paths algorithms: theory and experimental
-//! evaluation", Math. Programming 73, 1996). Only the lowest bucket is a binary heap; later
-//! buckets are plain vectors, heapified when they become the lowest. With a consistent heuristic
-//! f never decreases along a search and a node's f exceeds its parent's by at most a bounded
-//! `spread`, so a ring of buckets covering `spread` holds every entry (a spill list catches
-//! rounding surprises). Pops come out in exactly the order of a single binary heap over the same
-//! keys — the heaps are just a few hundred entries instead of tens of thousands.
+//! evaluation", Math. Programming 73, 1996). With a consistent heuristic f never decreases along
+//! a search and a node's f exceeds its parent's by at most a bounded `spread`, so a ring of
+//! buckets covering `spread` holds every entry (a spill list catches rounding surprises).
+//! Buckets are plain vectors; when one becomes the lowest it is sorted once, and the few entries
+//! pushed into it afterwards (about 8 % on the hospital queries: moves that keep f) go to a small
+//! binary heap; a pop takes the lower of the two heads. Pops come out in exactly the order of a
+//! single binary heap over the same keys, but each is a step along a sorted vector of a few dozen
+//! entries instead of a pop from a heap of tens of thousands (sorting a bucket once rather than
+//! heaping it: 21 -> 18 ms on the cross-building queries).
+//!
+//! A* pushes a node again whenever it finds a cheaper way there, leaving the old entry behind;
+//! about half the entries end up stale. [`OpenList::pop`] takes a `live` test and drops the
+//! entries that fail it when their bucket becomes the lowest, before it is sorted: almost
+//! every stale entry is superseded by then, so they cost one test each instead of a heap push
+//! and pop (cross-building hospital queries 30 -> 21 ms).
 
 use std::collections::BinaryHeap;
 
@@ -36,9 +45,12 @@ const RING: usize = 256;
 pub struct OpenList {
     /// Buckets per unit of f.
     inv_width: f32,
-    /// Bucket number of `heap`; lower-numbered entries go there too.
+    /// Number of the current bucket; lower-numbered entries go there too.
     base: u64,
-    heap: BinaryHeap<Entry>,
+    /// The current bucket as it was when it came up, sorted so that the lowest entry is last.
+    sorted: Vec<Entry>,
+    /// Entries pushed into the current bucket after it came up.
+    late: BinaryHeap<Entry>,
     /// Bucket b (base < b < base + RING) is `ring[b % RING]`.
     ring: Vec<Vec<Entry>>,
     /// Entries beyond the ring (not expected with a consistent heuristic).
@@ -54,7 +66,8 @@ impl OpenList {
         if self.ring.len() != RING {
             self.ring = vec![Vec::new(); RING];
         }
-        self.heap.clear();
+        self.sorted.clear();
+        self.late.clear();
         for b in &mut self.ring {
             b.clear();
         }
@@ -76,7 +89,7 @@ impl OpenList {
     pub fn push(&mut self, e: Entry) {
         let b = self.bucket(f32::from_bits((e.key >> 32) as u32));
         if b <= self.base {
-            self.heap.push(e);
+            self.late.push(e);
         } else if b - self.base < RING as u64 {
             self.ring[(b % RING as u64) as usize].push(e);
             self.pending += 1;
@@ -86,10 +99,17 @@ impl OpenList {
         }
     }
 
-    pub fn pop(&mut self) -> Option<Entry> {
+    /// The lowest entry. Entries for which `live` is false when their bucket becomes the lowest
+    /// are dropped; `live` must stay false for an entry once it is (the caller still has to
+    /// skip entries that died after their bucket came up).
+    pub fn pop(&mut self, live: impl Fn(&Entry) -> bool) -> Option<Entry> {
         loop {
-            if let Some(e) = self.heap.pop() {
-                return Some(e);
+            // the lower of the two heads (`Entry`'s order is reversed: greater = popped first)
+            match (self.sorted.last(), self.late.peek()) {
+                (Some(a), Some(b)) if b > a => return self.late.pop(),
+                (Some(_), _) => return self.sorted.pop(),
+                (None, Some(_)) => return self.late.pop(),
+                (None, None) => {}
             }
             if self.pending == 0 {
                 return None;
@@ -104,7 +124,10 @@ impl OpenList {
             }
             let slot = (self.base % RING as u64) as usize;
             self.pending -= self.ring[slot].len();
-            self.heap.extend(self.ring[slot].drain(..));
+            // the bucket's vector becomes `sorted`, the emptied `sorted` takes its place
+            std::mem::swap(&mut self.sorted, &mut self.ring[slot]);
+            self.sorted.retain(|e| live(e));
+            self.sorted.sort_unstable();
             if !self.spill.is_empty() {
                 // move spilled entries that now fall inside the ring
                 let spill = std::mem::take(&mut self.spill);
@@ -156,7 +179,7 @@ mod tests {
                 heap.push(e);
             }
             for _ in 0..2 {
-                let (a, b) = (open.pop(), heap.pop());
+                let (a, b) = (open.pop(|_| true), heap.pop());
                 assert_eq!(a, b, "after {popped} pops");
                 if let Some(e) = a {
                     f_min = f32::from_bits((e.key >> 32) as u32);
@@ -165,8 +188,58 @@ mod tests {
             }
         }
         while let Some(b) = heap.pop() {
-            assert_eq!(open.pop(), Some(b));
+            assert_eq!(open.pop(|_| true), Some(b));
         }
-        assert_eq!(open.pop(), None);
+        assert_eq!(open.pop(|_| true), None);
+    }
+
+    #[test]
+    fn dropping_dead_entries_keeps_the_order_of_the_live_ones() {
+        let mut state = 11u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as u32
+        };
+        // an entry is dead if its index is a multiple of 3 (a fixed test, as A*'s "closed or
+        // superseded" never comes back to life)
+        let live = |e: &Entry| !e.idx.is_multiple_of(3);
+        let mut open = OpenList::default();
+        open.reset(4.0, 10.0);
+        let mut heap = BinaryHeap::new();
+        let mut f_min = 10.0f32;
+        // the list may hand out dead entries whose bucket had already come up; skip those on both sides
+        let next_live = |open: &mut OpenList, heap: &mut BinaryHeap<Entry>| {
+            let a = std::iter::from_fn(|| open.pop(live)).find(live);
+            let b = std::iter::from_fn(|| heap.pop()).find(live);
+            (a, b)
+        };
+        let mut popped = 0;
+        for _ in 0..3000 {
+            for _ in 0..3 {
+                let f = f_min + (next() % 400) as f32 / 100.0;
+                let e = entry(f, (next() % 50) as f32 / 7.0, next() % 1000);
+                open.push(e);
+                heap.push(e);
+            }
+            for _ in 0..2 {
+                let (a, b) = next_live(&mut open, &mut heap);
+                assert!(a == b, "after {popped} live pops: {a:?} vs {b:?}");
+                if let Some(e) = a {
+                    f_min = f32::from_bits((e.key >> 32) as u32);
+                    popped += 1;
+                }
+            }
+        }
+        loop {
+            let (a, b) = next_live(&mut open, &mut heap);
+            assert!(a == b, "after {popped} live pops: {a:?} vs {b:?}");
+            if a.is_none() {
+                break;
+            }
+            popped += 1;
+        }
+        assert!(popped > 3000, "{popped}");
     }
 }
