@@ -19,7 +19,10 @@ use systems::localization::{
     OdometryModel, WheelOdometry,
 };
 use systems::navigation::{Behaviour, NavigationPlugin};
-use systems::sensors::{Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin};
+use systems::sensors::{
+    Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
+    SonarTruth, Sonars,
+};
 use systems::world::StaticWorld;
 
 /// A world ready to step.
@@ -159,6 +162,17 @@ fn spawn_robot(
                 spec.ticks_per_rev,
                 r.start,
             ),
+        ));
+    }
+    if let Some(s) = &r.sonar {
+        e.insert((
+            Sonars::new(
+                s.spec.clone(),
+                s.mounts.clone(),
+                stream_rng(seed, &r.name, "sonar"),
+            ),
+            SonarReadings::default(),
+            SonarTruth::default(),
         ));
     }
     let id = e.id();

@@ -6,7 +6,7 @@ use bevy_ecs::prelude::*;
 use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::SimClock;
 use systems::navigation::Behaviour;
-use systems::sensors::{Encoder, Laser};
+use systems::sensors::{Encoder, Laser, Sonars};
 
 #[derive(Resource)]
 pub struct EventQueue {
@@ -44,13 +44,15 @@ pub fn fire_events(
         &mut TruePose,
         Option<&mut Laser>,
         Option<&mut Encoder>,
+        Option<&mut Sonars>,
     )>,
 ) {
     let now = clock.start();
     while queue.next < queue.events.len() && queue.events[queue.next].0.at <= now + 1e-9 {
         let (event, entity) = queue.events[queue.next].clone();
         queue.next += 1;
-        let Ok((mut behaviour, body, mut truth, laser, encoder)) = robots.get_mut(entity) else {
+        let Ok((mut behaviour, body, mut truth, laser, encoder, sonars)) = robots.get_mut(entity)
+        else {
             continue;
         };
         let what = match &event.action {
@@ -76,6 +78,11 @@ pub fn fire_events(
                     SensorName::Encoder => {
                         if let Some(mut e) = encoder {
                             e.enabled = !active;
+                        }
+                    }
+                    SensorName::Sonar => {
+                        if let Some(mut s) = sonars {
+                            s.enabled = !active;
                         }
                     }
                 }

@@ -156,6 +156,7 @@ pub struct BehaviourFile {
 pub struct SensorsFile {
     pub laser: Option<LaserFile>,
     pub encoder: Option<EncoderFile>,
+    pub sonar: Option<super::sonar::SonarFile>,
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -198,6 +199,7 @@ pub enum EventType {
 pub enum SensorName {
     Laser,
     Encoder,
+    Sonar,
 }
 
 #[derive(Deserialize, Debug)]

@@ -7,10 +7,12 @@ pub mod error;
 pub mod file;
 pub mod localizers;
 pub mod resolve;
+pub mod sonar;
 
 pub use error::ScenarioError;
 pub use file::SensorName;
 pub use localizers::{LocalizerConfig, LocalizerKind};
+pub use sonar::SonarConfig;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -74,6 +76,7 @@ pub struct RobotConfig {
     pub tolerance: f64,
     pub laser: Option<LaserSpec>,
     pub encoder: Option<EncoderSpec>,
+    pub sonar: Option<SonarConfig>,
     pub localizers: Vec<LocalizerConfig>,
 }
 
