@@ -9,3 +9,4 @@ mod physics;
 mod recording;
 mod scenarios;
 mod sensors;
+mod sonar;
