@@ -96,6 +96,7 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
             tolerance: 0.4,
             laser: Some(swarm_laser(beams)),
             encoder: None,
+            sonar: None,
             localizers: Vec::new(),
             navigation: None,
         });

@@ -19,7 +19,10 @@ use systems::localization::{
     NavSource, OdometryModel, WheelOdometry,
 };
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
-use systems::sensors::{Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin};
+use systems::sensors::{
+    Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
+    SonarTruth, Sonars,
+};
 use systems::world::{Door, Doors, StaticWorld};
 
 /// A world ready to step.
@@ -189,6 +192,17 @@ fn spawn_robot(
                 spec.ticks_per_rev,
                 r.start,
             ),
+        ));
+    }
+    if let Some(s) = &r.sonar {
+        e.insert((
+            Sonars::new(
+                s.spec.clone(),
+                s.mounts.clone(),
+                stream_rng(seed, &r.name, "sonar"),
+            ),
+            SonarReadings::default(),
+            SonarTruth::default(),
         ));
     }
     let id = e.id();

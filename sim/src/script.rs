@@ -9,7 +9,7 @@ use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::SimClock;
 use systems::localization::LocalizationMap;
 use systems::navigation::Behaviour;
-use systems::sensors::{Encoder, Laser};
+use systems::sensors::{Encoder, Laser, Sonars};
 use systems::world::{Doors, StaticWorld};
 
 #[derive(Resource)]
@@ -55,6 +55,7 @@ pub fn fire_events(
         &mut TruePose,
         Option<&mut Laser>,
         Option<&mut Encoder>,
+        Option<&mut Sonars>,
     )>,
 ) {
     let now = clock.start();
@@ -71,7 +72,7 @@ pub fn fire_events(
             queue.fired.push((now, String::new(), what));
             continue;
         }
-        let Some(Ok((behaviour, body, mut truth, laser, encoder))) =
+        let Some(Ok((behaviour, body, mut truth, laser, encoder, sonars))) =
             entity.map(|e| robots.get_mut(e))
         else {
             continue;
@@ -102,6 +103,11 @@ pub fn fire_events(
                     SensorName::Encoder => {
                         if let Some(mut e) = encoder {
                             e.enabled = !active;
+                        }
+                    }
+                    SensorName::Sonar => {
+                        if let Some(mut s) = sonars {
+                            s.enabled = !active;
                         }
                     }
                 }

@@ -5,6 +5,8 @@
 //! - `robots/<name>/body`: the footprint outline;
 //! - `robots/<name>/odometry`: wheel-odometry pose and path;
 //! - `robots/<name>/scan`: the latest scan's endpoints in the world frame;
+//! - `robots/<name>/sonar`: the latest sonar readings, each finite one drawn as its beam's
+//!   outline (sensor → arc across the cone at the measured range), at the scan rate;
 //! - `robots/<name>/estimate/<localizer>`: each localizer's pose (arrow, at every estimate it
 //!   publishes) and its estimate path (line strip, at the path rate, like the odometry's);
 //!   `…/estimate/<localizer>/covariance`: the 2-σ ellipse of the (x, y) covariance and the ±2σ
@@ -31,7 +33,7 @@ use systems::core::clock::RateTimer;
 use systems::core::{Pose2, RobotId, RobotIndex, SimClock, wrap_angle};
 use systems::eval::LocalizationSamples;
 use systems::localization::{Localizer, Localizers, PoseEstimate, WheelOdometry};
-use systems::sensors::{LaserScans, LaserTruth};
+use systems::sensors::{LaserScans, LaserTruth, SonarReadings, SonarTruth, Sonars};
 use systems::world::{Cell, OccupancyGrid};
 
 /// Minimum spacing of recorded path points (m).
@@ -208,6 +210,30 @@ fn cloud(c: &Cloud) -> rerun::Points3D {
         .with_radii([c.radius])
 }
 
+/// The finite sonar readings in the world frame, from the true base pose at their firing: per
+/// sonar, the sensor → an arc across its cone at the measured range → the sensor.
+fn sonar_echoes(s: &Sonars, ranges: &[f32], base: &Pose2, c: rerun::Color) -> rerun::LineStrips3D {
+    const ARC: usize = 8;
+    let cone = s.spec.cone;
+    let strips: Vec<Vec<[f32; 3]>> = s
+        .mounts
+        .iter()
+        .zip(ranges)
+        .filter(|(_, r)| r.is_finite())
+        .map(|(m, &r)| {
+            let sensor = base.compose(m);
+            let o = [sensor.x as f32, sensor.y as f32, 0.0];
+            let arc = (0..=ARC).map(|k| {
+                let a = cone * (k as f64 / ARC as f64 - 0.5);
+                let w = sensor.transform_point([r as f64 * a.cos(), r as f64 * a.sin()]);
+                [w[0] as f32, w[1] as f32, 0.0]
+            });
+            std::iter::once(o).chain(arc).chain([o]).collect()
+        })
+        .collect();
+    rerun::LineStrips3D::new(strips).with_colors([c])
+}
+
 /// Colour of a robot's `k`-th localizer (its estimate arrow, path and covariance).
 fn localizer_colour(k: usize) -> rerun::Color {
     colour(k as u32 + 1)
@@ -336,6 +362,7 @@ pub fn record_rrd(
         Option<&WheelOdometry>,
         Option<(&LaserScans, &LaserTruth)>,
         Option<(&Localizers, &LocalizationSamples)>,
+        Option<(&Sonars, &SonarReadings, &SonarTruth)>,
     )>,
 ) {
     let r = &mut *r;
@@ -357,7 +384,7 @@ pub fn record_rrd(
     r.rec.set_duration_secs("sim_time", now);
     let mut sorted: Vec<_> = robots.iter().collect();
     sorted.sort_by_key(|(i, ..)| **i);
-    for (idx, id, truth, footprint, odom, laser, locs) in sorted {
+    for (idx, id, truth, footprint, odom, laser, locs, sonar) in sorted {
         let i = idx.0 as usize;
         if r.truth_paths.len() <= i {
             r.truth_paths.resize_with(i + 1, Vec::new);
@@ -432,6 +459,14 @@ pub fn record_rrd(
                 .with_radii([0.03])
                 .with_colors([c]);
             let res = r.rec.log(format!("{base}/scan"), &cloud);
+            r.check(res);
+        }
+        if scans_due
+            && let Some((sonars, readings, st)) = sonar
+            && let Some(pose) = &st.latest
+        {
+            let echoes = sonar_echoes(sonars, &readings.latest, pose, c);
+            let res = r.rec.log(format!("{base}/sonar"), &echoes);
             r.check(res);
         }
     }

@@ -206,6 +206,7 @@ pub struct BehaviourFile {
 pub struct SensorsFile {
     pub laser: Option<LaserFile>,
     pub encoder: Option<EncoderFile>,
+    pub sonar: Option<super::sonar::SonarFile>,
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -249,6 +250,7 @@ pub enum EventType {
 pub enum SensorName {
     Laser,
     Encoder,
+    Sonar,
 }
 
 #[derive(Deserialize, Debug)]

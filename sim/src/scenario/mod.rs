@@ -8,11 +8,13 @@ pub mod file;
 pub mod localizers;
 pub mod navigation;
 pub mod resolve;
+pub mod sonar;
 
 pub use error::ScenarioError;
 pub use file::SensorName;
 pub use localizers::{LocalizerConfig, LocalizerKind};
 pub use navigation::NavConfig;
+pub use sonar::SonarConfig;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -88,6 +90,7 @@ pub struct RobotConfig {
     pub tolerance: f64,
     pub laser: Option<LaserSpec>,
     pub encoder: Option<EncoderSpec>,
+    pub sonar: Option<SonarConfig>,
     pub localizers: Vec<LocalizerConfig>,
     /// Task-driven navigation (planner, follower, task queue), if the robot has tasks.
     pub navigation: Option<NavConfig>,

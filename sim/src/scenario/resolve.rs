@@ -372,6 +372,15 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             Some(e) => Some(resolve_encoder(&c, &sp.key("encoder"), e)?),
             None => None,
         };
+        let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
+            Some(s) => {
+                let sp = sp.key("sonar");
+                Some(super::sonar::resolve_sonar(
+                    &c, &sp, &r.name, &footprint, s,
+                )?)
+            }
+            None => None,
+        };
         let lp = p.key("localization");
         let localizers = super::localizers::resolve_localizers(
             &c,
@@ -449,6 +458,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             tolerance,
             laser,
             encoder,
+            sonar,
             localizers,
             navigation,
         });
@@ -572,11 +582,15 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
                 only("loop", e.looping.is_some(), "sensor_fault")?;
                 only("pose", e.pose.is_some(), "sensor_fault")?;
                 let Some(sensor) = e.sensor else {
-                    return c.err(&p, "a sensor_fault event needs `sensor` (laser or encoder)");
+                    return c.err(
+                        &p,
+                        "a sensor_fault event needs `sensor` (laser, encoder or sonar)",
+                    );
                 };
                 let has = match sensor {
                     SensorName::Laser => robot.laser.is_some(),
                     SensorName::Encoder => robot.encoder.is_some(),
+                    SensorName::Sonar => robot.sonar.is_some(),
                 };
                 if !has {
                     return c.err(

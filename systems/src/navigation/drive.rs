@@ -10,7 +10,7 @@ use super::shared_costmaps::NavCostmaps;
 use crate::body::DriveCommand;
 use crate::core::{KernelPool, RobotIndex, SimClock};
 use crate::localization::NavBelief;
-use crate::sensors::{Laser, LaserScans};
+use crate::sensors::{Laser, LaserScans, SonarReadings, Sonars};
 use bevy_ecs::prelude::*;
 use rayon::prelude::*;
 
@@ -54,6 +54,7 @@ pub fn drive_navigators(
         &NavBelief,
         &mut DriveCommand,
         Option<(&Laser, &LaserScans)>,
+        Option<(&Sonars, &SonarReadings)>,
     )>,
 ) {
     let Some(costmaps) = costmaps else {
@@ -67,7 +68,7 @@ pub fn drive_navigators(
         .unwrap_or(0);
     fleet.entries.clear();
     fleet.entries.resize(n, None);
-    for (idx, nav, belief, _, _) in robots.iter() {
+    for (idx, nav, belief, ..) in robots.iter() {
         fleet.entries[idx.0 as usize] = Some(nav.fleet_entry(idx.0, &belief.pose));
     }
     let fleet = &*fleet;
@@ -76,7 +77,31 @@ pub fn drive_navigators(
     let mut jobs: Vec<_> = robots.iter_mut().collect();
     pool.install(|| {
         jobs.par_iter_mut()
-            .for_each(|(idx, nav, belief, cmd, laser)| {
+            .for_each(|(idx, nav, belief, cmd, laser, sonar)| {
+                // sonar echoes join the laser points of the stop check (the laser is blind
+                // behind and below its plane; the sonars cover front, ±45° and rear)
+                nav.extra.clear();
+                if let Some((sonars, readings)) = sonar
+                    && sonars.enabled
+                {
+                    for (m, &r) in sonars.mounts.iter().zip(&readings.latest) {
+                        let r = if r == f32::NEG_INFINITY {
+                            sonars.spec.min_range as f32
+                        } else {
+                            r
+                        };
+                        if r.is_finite() {
+                            // the echo is somewhere in the cone at that range: an arc of points
+                            let half = sonars.spec.cone / 2.0;
+                            for k in 0..7 {
+                                let a = -half + half * k as f64 / 3.0;
+                                let (sa, ca) = a.sin_cos();
+                                let p = m.transform_point([r as f64 * ca, r as f64 * sa]);
+                                nav.extra.push((p[0] as f32, p[1] as f32));
+                            }
+                        }
+                    }
+                }
                 if let Some((laser, scans)) = laser {
                     if let Some(scan) = scans.scans.last() {
                         nav.seen = Some(SectorRanges::from_scan(scan, &laser.spec.mount));

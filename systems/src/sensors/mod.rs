@@ -5,9 +5,11 @@
 pub mod encoder;
 pub mod laser;
 pub mod others;
+pub mod sonar;
 
 pub use encoder::{Encoder, EncoderReading, EncoderReadings, EncoderSpec};
 pub use laser::{Laser, LaserScan, LaserScans, LaserSpec, LaserTruth};
+pub use sonar::{SonarReadings, SonarSpec, SonarTruth, Sonars};
 
 use crate::core::{SimPlugin, SimSet};
 use bevy_ecs::prelude::*;
@@ -21,6 +23,7 @@ impl SimPlugin for SensorsPlugin {
             (
                 others::update_robot_outlines,
                 laser::sample_lasers,
+                sonar::sample_sonars,
                 encoder::sample_encoders,
             )
                 .chain()

@@ -10,3 +10,4 @@ mod physics;
 mod recording;
 mod scenarios;
 mod sensors;
+mod sonar;
