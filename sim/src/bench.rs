@@ -111,6 +111,7 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
         record: RecordConfig::default(),
         robots,
         events: Vec::new(),
+        people: Vec::new(),
     }
 }
 

@@ -6,11 +6,13 @@
 pub mod error;
 pub mod file;
 pub mod localizers;
+pub mod people;
 pub mod resolve;
 
 pub use error::ScenarioError;
 pub use file::SensorName;
 pub use localizers::{LocalizerConfig, LocalizerKind};
+pub use people::PersonConfig;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -35,6 +37,8 @@ pub struct Scenario {
     pub record: RecordConfig,
     pub robots: Vec<RobotConfig>,
     pub events: Vec<Event>,
+    /// Walking people, in file order.
+    pub people: Vec<PersonConfig>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -456,6 +456,8 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
     }
     // stable: events at the same time fire in file order
     events.sort_by(|a, b| a.at.total_cmp(&b.at));
+    let people =
+        super::people::resolve_people(&c, &root.key("people"), &f.people, &point, &inside, &grid)?;
 
     Ok(Scenario {
         name,
@@ -469,6 +471,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         record,
         robots,
         events,
+        people,
     })
 }
 

@@ -5,6 +5,7 @@ mod common;
 mod determinism;
 mod events;
 mod localization;
+mod people;
 mod physics;
 mod recording;
 mod scenarios;
