@@ -115,6 +115,7 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
         events: Vec::new(),
         doors: Vec::new(),
         end_when_done: false,
+        people: Vec::new(),
     }
 }
 

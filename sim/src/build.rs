@@ -1,11 +1,12 @@
-//! World building: a validated scenario becomes an ECS world (resources and one entity per robot)
-//! and the tick schedule composed from the feature plugins of `systems`.
+//! World building: a validated scenario becomes an ECS world (resources, one entity per robot and
+//! one per walking person) and the tick schedule composed from the feature plugins of `systems`.
 
-use crate::scenario::{LocalizerKind, RobotConfig, Scenario};
+use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
 use crate::script::{EventQueue, fire_events};
 use bevy_ecs::prelude::*;
 use systems::body::{
-    DriveCommand, DriveState, Kinematics, Physics, PhysicsPlugin, TruePose, TrueTwist,
+    DriveCommand, DriveState, Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics,
+    PhysicsPlugin, TruePose, TrueTwist, Walker,
 };
 use systems::core::{
     KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimSet, new_schedule, stream_rng,
@@ -31,6 +32,8 @@ pub struct SimWorld {
     pub schedule: Schedule,
     /// Robot entities in spawn (index) order.
     pub robots: Vec<Entity>,
+    /// Walking people in spawn (index) order.
+    pub people: Vec<Entity>,
 }
 
 impl SimWorld {
@@ -101,6 +104,12 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
         }
         robots.push(e);
     }
+    let people = scenario
+        .people
+        .iter()
+        .enumerate()
+        .map(|(k, p)| spawn_person(&mut world, &mut physics, scenario.seed, k as u32, p))
+        .collect();
     if let Some(maps) = costmaps {
         world.insert_resource(maps);
     }
@@ -113,8 +122,9 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
 
     let mut schedule = new_schedule();
     schedule.add_systems(fire_events.in_set(SimSet::Script));
-    let plugins: [&dyn SimPlugin; 5] = [
+    let plugins: [&dyn SimPlugin; 6] = [
         &NavigationPlugin,
+        &PeoplePlugin,
         &PhysicsPlugin,
         &SensorsPlugin,
         &LocalizationPlugin,
@@ -127,7 +137,32 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
         world,
         schedule,
         robots,
+        people,
     })
+}
+
+/// A walking person: a physics disc at its first route point, its script and walking state
+/// (random draws from its own `walk` stream).
+fn spawn_person(
+    world: &mut World,
+    physics: &mut Physics,
+    seed: u64,
+    index: u32,
+    p: &PersonConfig,
+) -> Entity {
+    let start = p.person.start_pose();
+    let body = physics.add_person(index, start.x, start.y, p.person.radius);
+    let walker = Walker::new(&p.person, stream_rng(seed, &p.name, "walk"));
+    world
+        .spawn((
+            PersonId(p.name.clone()),
+            PersonIndex(index),
+            p.person.clone(),
+            walker,
+            TruePose::at(start),
+            body,
+        ))
+        .id()
 }
 
 fn odometry_model(kin: &Kinematics, enc: &systems::sensors::EncoderSpec) -> OdometryModel {

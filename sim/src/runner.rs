@@ -325,6 +325,7 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                     collisions: m.collisions.total(),
                     wall_collisions: m.collisions.wall,
                     robot_collisions: m.collisions.robot,
+                    person_collisions: m.collisions.person,
                     odometry_drift_m: m.odometry_drift_m,
                     max_odometry_drift_m: m.max_odometry_drift_m,
                     odometry_drift_percent: if m.distance_m > 0.0 {

@@ -19,10 +19,11 @@ pub struct RobotSummary {
     pub name: String,
     /// Ground-truth distance driven (m).
     pub distance_m: f64,
-    /// Contact starts with walls and other robots.
+    /// Contact starts with walls, other robots and walking people.
     pub collisions: u32,
     pub wall_collisions: u32,
     pub robot_collisions: u32,
+    pub person_collisions: u32,
     /// Final wheel-odometry position error (m).
     pub odometry_drift_m: f64,
     pub max_odometry_drift_m: f64,
@@ -95,24 +96,26 @@ impl Summary {
             self.scenario, self.seed, self.sim_time_s, self.wall_time_s, self.real_time_factor
         );
         s += &format!(
-            "{:<16} {:>11} {:>10} {:>6} {:>7} {:>13} {:>8} {:>10}\n",
+            "{:<16} {:>11} {:>10} {:>6} {:>7} {:>7} {:>13} {:>8} {:>10}\n",
             "robot",
             "distance m",
             "collisions",
             "walls",
             "robots",
+            "people",
             "odom drift m",
             "drift %",
             "waypoints"
         );
         for r in &self.robots {
             s += &format!(
-                "{:<16} {:>11.2} {:>10} {:>6} {:>7} {:>13.3} {:>8.2} {:>10}\n",
+                "{:<16} {:>11.2} {:>10} {:>6} {:>7} {:>7} {:>13.3} {:>8.2} {:>10}\n",
                 r.name,
                 r.distance_m,
                 r.collisions,
                 r.wall_collisions,
                 r.robot_collisions,
+                r.person_collisions,
                 r.odometry_drift_m,
                 r.odometry_drift_percent,
                 r.waypoints_reached

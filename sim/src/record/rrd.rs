@@ -22,13 +22,17 @@
 //!   `…/error/<localizer>/heading`: the absolute heading error (rad). The recorder reads ground
 //!   truth; the localizers never do.
 //!
+//! - `people/<name>`: each walking person as a disc of its radius (a point with that radius,
+//!   labelled with its name) at the pose rate, and `people/<name>/trail`: its last few metres.
+//!
 //! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
 
 use super::belief::{self, Cloud};
 use crate::scenario::RecordConfig;
 use bevy_ecs::prelude::*;
+use std::collections::VecDeque;
 use std::path::Path;
-use systems::body::{Footprint, TruePose};
+use systems::body::{Footprint, Person, PersonId, PersonIndex, TruePose};
 use systems::core::clock::RateTimer;
 use systems::core::{Pose2, RobotId, RobotIndex, SimClock, wrap_angle};
 use systems::eval::LocalizationSamples;
@@ -38,6 +42,8 @@ use systems::world::{Cell, OccupancyGrid};
 
 /// Minimum spacing of recorded path points (m).
 const PATH_SPACING: f64 = 0.05;
+/// Points kept in a person's trail (at the pose rate: 3 s at the default 10 Hz).
+const TRAIL_POINTS: usize = 30;
 
 #[derive(Resource)]
 pub struct RrdRecorder {
@@ -47,6 +53,8 @@ pub struct RrdRecorder {
     path_timer: RateTimer,
     truth_paths: Vec<Vec<[f32; 3]>>,
     odom_paths: Vec<Vec<[f32; 3]>>,
+    /// Per person (by index): the last poses logged.
+    trails: Vec<VecDeque<[f32; 3]>>,
     /// Per robot (by index), per localizer (in the robot's order).
     tracks: Vec<Vec<Track>>,
     particle_period: f64,
@@ -118,6 +126,7 @@ impl RrdRecorder {
             path_timer: RateTimer::new(config.path_rate, 0.0),
             truth_paths: Vec::new(),
             odom_paths: Vec::new(),
+            trails: Vec::new(),
             tracks: Vec::new(),
             particle_period: 1.0 / config.particle_rate,
             particle_points: config.particle_points,
@@ -364,6 +373,7 @@ pub fn record_rrd(
         Option<(&Localizers, &LocalizationSamples)>,
         Option<(&Sonars, &SonarReadings, &SonarTruth)>,
     )>,
+    people: Query<(&PersonIndex, &PersonId, &Person, &TruePose)>,
 ) {
     let r = &mut *r;
     let (start, now) = (clock.start(), clock.now());
@@ -382,6 +392,9 @@ pub fn record_rrd(
         return;
     }
     r.rec.set_duration_secs("sim_time", now);
+    if poses_due {
+        record_people(r, &people);
+    }
     let mut sorted: Vec<_> = robots.iter().collect();
     sorted.sort_by_key(|(i, ..)| **i);
     for (idx, id, truth, footprint, odom, laser, locs, sonar) in sorted {
@@ -467,6 +480,41 @@ pub fn record_rrd(
         {
             let echoes = sonar_echoes(sonars, &readings.latest, pose, c);
             let res = r.rec.log(format!("{base}/sonar"), &echoes);
+            r.check(res);
+        }
+    }
+}
+
+/// Logs every person (in index order) as a disc of its radius and its recent trail.
+fn record_people(
+    r: &mut RrdRecorder,
+    people: &Query<(&PersonIndex, &PersonId, &Person, &TruePose)>,
+) {
+    let mut sorted: Vec<_> = people.iter().collect();
+    sorted.sort_by_key(|(i, ..)| **i);
+    let c = rerun::Color::from_rgb(230, 90, 40);
+    for (idx, id, person, truth) in sorted {
+        let i = idx.0 as usize;
+        if r.trails.len() <= i {
+            r.trails.resize_with(i + 1, VecDeque::new);
+        }
+        let p = [truth.pose.x as f32, truth.pose.y as f32, 0.0];
+        let trail = &mut r.trails[i];
+        if trail.len() == TRAIL_POINTS {
+            trail.pop_front();
+        }
+        trail.push_back(p);
+        let trail: Vec<[f32; 3]> = trail.iter().copied().collect();
+        let base = format!("people/{}", id.0);
+        let disc = rerun::Points3D::new([p])
+            .with_radii([person.radius as f32])
+            .with_colors([c])
+            .with_labels([id.0.as_str()]);
+        let res = r.rec.log(base.as_str(), &disc);
+        r.check(res);
+        if trail.len() >= 2 {
+            let strip = rerun::LineStrips3D::new([trail]).with_colors([c]);
+            let res = r.rec.log(format!("{base}/trail"), &strip);
             r.check(res);
         }
     }

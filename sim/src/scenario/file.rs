@@ -25,6 +25,9 @@ pub struct ScenarioFile {
     pub robots: Vec<RobotFile>,
     #[serde(default)]
     pub events: Vec<EventFile>,
+    /// Walking people (`[[people]]` tables).
+    #[serde(default)]
+    pub people: Vec<super::people::PersonFile>,
 }
 
 #[derive(Deserialize, Debug, Default)]

@@ -7,6 +7,7 @@ pub mod error;
 pub mod file;
 pub mod localizers;
 pub mod navigation;
+pub mod people;
 pub mod resolve;
 pub mod sonar;
 
@@ -14,6 +15,7 @@ pub use error::ScenarioError;
 pub use file::SensorName;
 pub use localizers::{LocalizerConfig, LocalizerKind};
 pub use navigation::NavConfig;
+pub use people::PersonConfig;
 pub use sonar::SonarConfig;
 
 use std::collections::BTreeMap;
@@ -43,6 +45,8 @@ pub struct Scenario {
     pub doors: Vec<DoorConfig>,
     /// End the run as soon as every robot with tasks has done them all.
     pub end_when_done: bool,
+    /// Walking people, in file order.
+    pub people: Vec<PersonConfig>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -612,6 +612,8 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
     }
     // stable: events at the same time fire in file order
     events.sort_by(|a, b| a.at.total_cmp(&b.at));
+    let people =
+        super::people::resolve_people(&c, &root.key("people"), &f.people, &point, &inside, &grid)?;
 
     Ok(Scenario {
         name,
@@ -627,6 +629,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         events,
         doors,
         end_when_done: f.end_when_done.unwrap_or(false),
+        people,
     })
 }
 

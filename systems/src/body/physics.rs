@@ -6,9 +6,14 @@
 //!
 //! Collisions are counted as contact STARTS: a robot that touches the wall and slides along it
 //! (across several tile colliders) counts once, until it is free of every wall again.
+//!
+//! Walking people ([`super::people`]) are dynamic discs driven the same way, by the velocity
+//! their walker planned; a robot touching a person counts a person collision, while people
+//! touching walls or each other count nothing (they are not robots).
 
 use super::footprint::Footprint;
 use super::kinematics::{DriveCommand, DriveState, Kinematics, integrate_arc};
+use super::people::Walker;
 use crate::core::{Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
 use crate::world::{StaticWorld, rects::tile_rects};
 use bevy_ecs::prelude::*;
@@ -49,11 +54,13 @@ pub struct PhysicsBody(pub RigidBodyHandle);
 pub struct Collisions {
     pub wall: u32,
     pub robot: u32,
+    /// With walking people.
+    pub person: u32,
 }
 
 impl Collisions {
     pub fn total(&self) -> u32 {
-        self.wall + self.robot
+        self.wall + self.robot + self.person
     }
 }
 
@@ -86,8 +93,21 @@ impl EventHandler for EventBuffer {
     fn handle_soft_body_tear_event(&self, _soft_bodies: &SoftBodySet, _event: &SoftBodyTearEvent) {}
 }
 
-/// Robots' colliders carry `robot index + 1` as user data; static colliders carry 0.
+/// Robots' colliders carry `robot index + 1` as user data; static colliders carry 0; people
+/// carry `PERSON_TAG | person index` (robot indices are u32, so the tag never clashes).
 const STATIC_USER_DATA: u128 = 0;
+const PERSON_TAG: u128 = 1 << 64;
+
+/// Who a collider belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Owner {
+    Static,
+    Robot(u32),
+    Person,
+}
+
+/// Mass of a person (kg): what a robot pushing into one feels.
+const PERSON_MASS: f64 = 70.0;
 
 #[derive(Resource)]
 pub struct Physics {
@@ -177,6 +197,25 @@ impl Physics {
         PhysicsBody(handle)
     }
 
+    /// Adds person number `index` (spawn order) as a dynamic disc of `radius` at (x, y). Its
+    /// rotation is locked: a person's heading is where it walks, not how contacts spin it.
+    pub fn add_person(&mut self, index: u32, x: f64, y: f64, radius: f64) -> PhysicsBody {
+        let body = RigidBodyBuilder::dynamic()
+            .translation(Vector::new(x as Real, y as Real))
+            .lock_rotations()
+            .ccd_enabled(true)
+            .can_sleep(false)
+            .build();
+        let area = std::f64::consts::PI * radius * radius;
+        let collider = ColliderBuilder::ball(radius as Real)
+            .density((PERSON_MASS / area.max(1e-6)) as Real)
+            .friction(0.0)
+            .user_data(PERSON_TAG | index as u128)
+            .build();
+        let (handle, _) = self.world.insert(body, collider);
+        PhysicsBody(handle)
+    }
+
     /// Moves a body instantly (kidnapping), stopping it.
     pub fn teleport(&mut self, body: PhysicsBody, pose: &Pose2) {
         if let Some(b) = self.world.bodies.get_mut(body.0) {
@@ -199,9 +238,12 @@ impl Physics {
             .unwrap_or_default()
     }
 
-    fn robot_of(&self, h: ColliderHandle) -> Option<u32> {
-        let data = self.world.colliders.get(h).map(|c| c.user_data)?;
-        (data != STATIC_USER_DATA).then(|| (data - 1) as u32)
+    fn owner(&self, h: ColliderHandle) -> Owner {
+        match self.world.colliders.get(h).map(|c| c.user_data) {
+            None | Some(STATIC_USER_DATA) => Owner::Static,
+            Some(d) if d & PERSON_TAG != 0 => Owner::Person,
+            Some(d) => Owner::Robot((d - 1) as u32),
+        }
     }
 
     /// Turns this step's collision events into contact-start counts.
@@ -215,14 +257,15 @@ impl Physics {
                 CollisionEvent::Started(a, b, _) => (a, b, true),
                 CollisionEvent::Stopped(a, b, _) => (a, b, false),
             };
-            match (self.robot_of(h1), self.robot_of(h2)) {
-                (Some(a), Some(b)) => {
-                    if started {
-                        self.collisions[a as usize].robot += 1;
-                        self.collisions[b as usize].robot += 1;
-                    }
+            match (self.owner(h1), self.owner(h2)) {
+                (Owner::Robot(a), Owner::Robot(b)) if started => {
+                    self.collisions[a as usize].robot += 1;
+                    self.collisions[b as usize].robot += 1;
                 }
-                (Some(r), None) | (None, Some(r)) => {
+                (Owner::Robot(r), Owner::Person) | (Owner::Person, Owner::Robot(r)) if started => {
+                    self.collisions[r as usize].person += 1;
+                }
+                (Owner::Robot(r), Owner::Static) | (Owner::Static, Owner::Robot(r)) => {
                     let t = &mut self.wall_touching[r as usize];
                     if started {
                         if *t == 0 {
@@ -233,7 +276,8 @@ impl Physics {
                         *t = t.saturating_sub(1);
                     }
                 }
-                (None, None) => {}
+                // contact ends between bodies, people against walls or people: nothing to count
+                _ => {}
             }
         }
     }
@@ -242,7 +286,8 @@ impl Physics {
 /// rapier's 2-D pose type.
 type Pose2d = rapier2d::math::Pose;
 
-/// Physics: drive every robot along its commanded arc, resolve contacts, read back ground truth.
+/// Physics: drive every robot along its commanded arc and every person at its planned velocity,
+/// resolve contacts, read back ground truth.
 #[allow(clippy::type_complexity)]
 pub fn physics_step(
     mut physics: ResMut<Physics>,
@@ -256,6 +301,7 @@ pub fn physics_step(
         &mut TruePose,
         &mut TrueTwist,
     )>,
+    mut people: Query<(&PhysicsBody, &Walker, &mut TruePose), Without<Kinematics>>,
 ) {
     let dirty = world.take_dirty_tiles();
     for (tx, ty) in dirty {
@@ -284,10 +330,24 @@ pub fn physics_step(
             b.set_angvel((w) as Real, true);
         }
     }
+    for (body, walker, mut truth) in people.iter_mut() {
+        if let Some(b) = physics.world.bodies.get_mut(body.0) {
+            let t = b.translation();
+            truth.prev = Pose2::new(t.x as f64, t.y as f64, truth.pose.theta);
+            let v = walker.velocity;
+            b.set_linvel(Vector::new(v[0] as Real, v[1] as Real), true);
+        }
+    }
     let events = std::mem::take(&mut physics.events);
     physics.world.step_with_events(&(), &events);
     physics.events = events;
     physics.count_events();
+    for (body, walker, mut truth) in people.iter_mut() {
+        if let Some(b) = physics.world.bodies.get(body.0) {
+            let t = b.translation();
+            truth.pose = Pose2::new(t.x as f64, t.y as f64, walker.heading);
+        }
+    }
     for (body, _, _, _, mut truth, mut twist) in robots.iter_mut() {
         if let Some(b) = physics.world.bodies.get(body.0) {
             let t = b.translation();

@@ -1,7 +1,9 @@
-//! Other robots as laser obstacles: every robot's footprint in the world at the current tick,
-//! bucketed on a coarse grid so a laser only looks at robots within its range.
+//! Other robots and walking people as laser obstacles: every robot's footprint and every
+//! person's disc in the world at the current tick, bucketed on a coarse grid so a laser only
+//! looks at bodies within its range. People take the slots after the robots' (robot count +
+//! person index), so `except` (a robot index) never hides a person.
 
-use crate::body::{Footprint, TruePose};
+use crate::body::{Footprint, Person, PersonIndex, TruePose};
 use crate::core::RobotIndex;
 use bevy_ecs::prelude::*;
 
@@ -18,7 +20,7 @@ pub struct NearbyRobots {
 
 #[derive(Resource, Default)]
 pub struct RobotOutlines {
-    /// Per robot (by index): circle (cx, cy, r) or polygon edges.
+    /// Per robot (by index), then per person: circle (cx, cy, r) or polygon edges.
     circles: Vec<Option<[f32; 3]>>,
     polygons: Vec<Vec<[f32; 4]>>,
     centres: Vec<[f64; 3]>,
@@ -82,16 +84,23 @@ impl RobotOutlines {
     }
 }
 
-/// Sense (first): refresh every robot's outline.
+/// Sense (first): refresh every robot's outline and every person's disc.
 pub fn update_robot_outlines(
     mut outlines: ResMut<RobotOutlines>,
     robots: Query<(&RobotIndex, &TruePose, &Footprint)>,
+    people: Query<(&PersonIndex, &TruePose, &Person), Without<RobotIndex>>,
 ) {
-    let n = robots
+    let n_robots = robots
         .iter()
         .map(|(i, _, _)| i.0 as usize + 1)
         .max()
         .unwrap_or(0);
+    let n = n_robots
+        + people
+            .iter()
+            .map(|(i, _, _)| i.0 as usize + 1)
+            .max()
+            .unwrap_or(0);
     let o = &mut *outlines;
     o.circles.clear();
     o.circles.resize(n, None);
@@ -123,5 +132,77 @@ pub fn update_robot_outlines(
         let key = ((p.x / BUCKET).floor() as i32, (p.y / BUCKET).floor() as i32);
         o.buckets.entry(key).or_default().push(idx.0);
     }
+    for (idx, truth, person) in people.iter() {
+        let i = n_robots + idx.0 as usize;
+        let p = truth.pose;
+        o.centres[i] = [p.x, p.y, person.radius];
+        o.circles[i] = Some([p.x as f32, p.y as f32, person.radius as f32]);
+        let key = ((p.x / BUCKET).floor() as i32, (p.y / BUCKET).floor() as i32);
+        o.buckets.entry(key).or_default().push(i as u32);
+    }
     o.buckets.retain(|_, v| !v.is_empty());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::{KernelPool, Pose2, SimClock, stream_rng};
+    use crate::sensors::laser::{Laser, LaserScans, LaserSpec, LaserTruth, sample_lasers};
+    use crate::world::{Cell, OccupancyGrid, StaticWorld};
+
+    /// A noiseless laser on robot 0 looking along +x at a person standing 3 m ahead (centre),
+    /// radius 0.25: the middle beam measures 2.75 m; a second robot behind the person is hidden.
+    #[test]
+    fn a_laser_in_front_of_a_person_measures_the_person() {
+        let mut world = World::new();
+        let grid = OccupancyGrid::new(300, 300, 0.1, [-15.0, -15.0], Cell::Free);
+        world.insert_resource(StaticWorld::new(grid));
+        world.insert_resource(KernelPool::new(1).expect("pool"));
+        world.insert_resource(SimClock::new(0.1));
+        world.init_resource::<RobotOutlines>();
+        let mut spec = LaserSpec::sick_lms100();
+        spec.noise_std = 0.0;
+        spec.rate = 10.0;
+        let robot = world
+            .spawn((
+                RobotIndex(0),
+                TruePose::at(Pose2::new(0.0, 0.0, 0.0)),
+                Footprint::Circle { radius: 0.3 },
+                Laser::new(spec.clone(), stream_rng(1, "r", "laser")),
+                LaserScans::default(),
+                LaserTruth::default(),
+            ))
+            .id();
+        world.spawn((
+            RobotIndex(1),
+            TruePose::at(Pose2::new(6.0, 0.0, 0.0)),
+            Footprint::Circle { radius: 0.3 },
+        ));
+        world.spawn((
+            PersonIndex(0),
+            TruePose::at(Pose2::new(3.0, 0.0, 0.0)),
+            Person::new(vec![[3.0, 0.0], [3.0, 5.0]]),
+        ));
+        let mut schedule = Schedule::default();
+        schedule.add_systems((update_robot_outlines, sample_lasers).chain());
+        schedule.run(&mut world);
+        let scans = world.get::<LaserScans>(robot).expect("scans");
+        let scan = scans.latest.as_ref().expect("a scan");
+        let mid = spec.beams() / 2;
+        assert!(
+            (scan.ranges[mid] - 2.75).abs() < 1e-3,
+            "{}",
+            scan.ranges[mid]
+        );
+        // the person covers ±asin(0.25 / 3) ≈ ±4.8° around the axis
+        let k = (4.0f64.to_radians() / spec.increment) as usize;
+        assert!(scan.ranges[mid + k] < 3.0 && scan.ranges[mid - k] < 3.0);
+        assert!(scan.ranges[mid + 40].is_infinite(), "nothing else at 10°");
+        // a robot's `except` never hides a person
+        let outlines = world.resource::<RobotOutlines>();
+        let mut near = NearbyRobots::default();
+        outlines.near(0.0, 0.0, 10.0, 0, &mut near);
+        assert_eq!(near.circles.len(), 2, "the person and robot 1");
+        assert_eq!(near.circles[1], [3.0, 0.0, 0.25], "people after robots");
+    }
 }

@@ -6,6 +6,7 @@ mod determinism;
 mod events;
 mod localization;
 mod navigation;
+mod people;
 mod physics;
 mod recording;
 mod scenarios;

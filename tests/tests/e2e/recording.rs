@@ -70,6 +70,12 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
             want.push(format!("/robots/{}/{leaf}", r.name));
         }
     }
+    // walking people: a disc and a trail each
+    assert!(!s.people.is_empty(), "the patrol has people");
+    for p in &s.people {
+        want.push(format!("/people/{}", p.name));
+        want.push(format!("/people/{}/trail", p.name));
+    }
     let mut localizers = 0;
     for r in &s.robots {
         for l in &r.localizers {

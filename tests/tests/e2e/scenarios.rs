@@ -15,6 +15,7 @@ fn bundled_scenarios_load() {
     }
     let h = load_scenario(&bundled("hospital_patrol")).unwrap();
     assert!(h.robots.len() >= 4);
+    assert!(h.people.len() >= 2, "people walk the patrol's corridors");
     for r in &h.robots {
         let l = r.laser.as_ref().expect("every patrol robot has a laser");
         assert_eq!(l.beams(), 1081, "SICK LMS100");
