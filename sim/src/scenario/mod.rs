@@ -4,11 +4,14 @@
 //! errors naming the file, line and key. The format is documented in README.md.
 
 pub mod error;
+pub mod events;
 pub mod file;
 pub mod localizers;
 pub mod navigation;
 pub mod people;
+pub mod places;
 pub mod resolve;
+pub mod sensors;
 pub mod sonar;
 
 pub use error::ScenarioError;

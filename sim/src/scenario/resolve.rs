@@ -3,20 +3,20 @@
 
 use super::error::{ErrorContext, KeyPath, ScenarioError};
 use super::file::*;
-use super::{DoorConfig, Event, EventAction, RecordConfig, RobotConfig, Scenario};
+use super::sensors::{resolve_encoder, resolve_laser};
+use super::{RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};
 use systems::core::Pose2;
 use systems::navigation::BehaviourKind;
-use systems::sensors::{EncoderSpec, LaserSpec};
 use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
 use systems::world::{OccupancyGrid, load_map};
 
 pub(super) type R<T> = Result<T, ScenarioError>;
 
 pub(super) struct Checker<'a> {
-    cx: ErrorContext<'a>,
+    pub(super) cx: ErrorContext<'a>,
 }
 
 impl Checker<'_> {
@@ -170,59 +170,12 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         rasterize(&mut grid, s);
     }
 
-    let mut places = BTreeMap::new();
-    let mut doors = Vec::new();
-    if let Some(pf) = &map.places {
-        let ppath = base_dir.join(pf);
-        let ptext = std::fs::read_to_string(&ppath).map_err(|e| {
-            c.cx.at(
-                &mpath.key("places"),
-                format!("cannot read {}: {e}", ppath.display()),
-            )
-        })?;
-        let pcx = ErrorContext::new(ppath.display().to_string(), &ptext);
-        let parsed: PlacesFile = toml::from_str(&ptext).map_err(|e| pcx.from_toml(&e))?;
-        for (name, place) in parsed.places {
-            let pp = KeyPath::default().key("places").key(&name).key("pose");
-            if place.pose.iter().any(|v| !v.is_finite()) {
-                return Err(pcx.at(&pp, "expected [x, y, yaw] finite numbers"));
-            }
-            places.insert(
-                name,
-                Pose2::new(place.pose[0], place.pose[1], place.pose[2]),
-            );
+    let (places, doors) = match &map.places {
+        Some(pf) => {
+            super::places::load_places(&c, &mpath.key("places"), &base_dir.join(pf), &grid)?
         }
-        for (name, d) in parsed.doors {
-            let dp = KeyPath::default().key("doors").key(&name);
-            let b = grid.bounds();
-            for (key, v) in [("from", d.from), ("to", d.to)] {
-                if v.iter().any(|x| !x.is_finite())
-                    || v[0] < b[0]
-                    || v[1] < b[1]
-                    || v[0] > b[2]
-                    || v[1] > b[3]
-                {
-                    return Err(pcx.at(
-                        &dp.key(key),
-                        format!("expected a finite [x, y] inside the map, got {v:?}"),
-                    ));
-                }
-            }
-            let thickness = d.thickness.unwrap_or(0.15);
-            if !(thickness > 0.0 && thickness <= 2.0) {
-                return Err(pcx.at(
-                    &dp.key("thickness"),
-                    format!("expected a number in (0, 2] m, got {thickness}"),
-                ));
-            }
-            doors.push(DoorConfig {
-                name,
-                from: d.from,
-                to: d.to,
-                thickness,
-            });
-        }
-    }
+        None => (BTreeMap::new(), Vec::new()),
+    };
 
     let point = |path: &KeyPath, p: &PointOrPlace| -> R<Pose2> {
         match p {
@@ -464,154 +417,20 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         });
     }
 
-    // --- events
-    let mut events = Vec::new();
-    for (i, e) in f.events.iter().enumerate() {
-        let p = root.key("events").index(i);
-        let at = c.range(&p.key("at"), e.at, Some(0.0), Some(duration), false)?;
-        if e.kind == EventType::Door {
-            if e.robot.is_some() {
-                return c.err(
-                    &p.key("robot"),
-                    "a door event concerns no robot: remove `robot`",
-                );
-            }
-            for (key, present) in [
-                ("points", e.points.is_some()),
-                ("loop", e.looping.is_some()),
-                ("pose", e.pose.is_some()),
-                ("sensor", e.sensor.is_some()),
-                ("active", e.active.is_some()),
-            ] {
-                if present {
-                    return c.err(
-                        &p.key(key),
-                        format!("`{key}` does not apply to a `door` event"),
-                    );
-                }
-            }
-            let Some(door) = &e.door else {
-                return c.err(
-                    &p,
-                    "a door event needs `door` (a door of the map's places file)",
-                );
-            };
-            let Some(index) = doors.iter().position(|d| &d.name == door) else {
-                let known: Vec<&str> = doors.iter().map(|d| d.name.as_str()).collect();
-                return c.err(
-                    &p.key("door"),
-                    if known.is_empty() {
-                        format!("unknown door `{door}` (the map's places file defines no doors)")
-                    } else {
-                        format!("unknown door `{door}`; known doors: {}", known.join(", "))
-                    },
-                );
-            };
-            let Some(open) = e.open else {
-                return c.err(&p, "a door event needs `open` (true or false)");
-            };
-            events.push(Event {
-                at,
-                robot: None,
-                action: EventAction::Door { index, open },
-            });
-            continue;
-        }
-        if e.door.is_some() || e.open.is_some() {
-            let key = if e.door.is_some() { "door" } else { "open" };
-            return c.err(
-                &p.key(key),
-                format!("`{key}` applies to `door` events only"),
-            );
-        }
-        let Some(robot_name) = &e.robot else {
-            return c.err(&p, "missing key `robot` (the robot the event concerns)");
-        };
-        let Some(robot) = robots.iter().find(|r| &r.name == robot_name) else {
-            return c.err(&p.key("robot"), format!("no robot named `{robot_name}`"));
-        };
-        let only = |key: &str, present: bool, kind: &str| -> R<()> {
-            if present {
-                return c.err(
-                    &p.key(key),
-                    format!("`{key}` does not apply to a `{kind}` event"),
-                );
-            }
-            Ok(())
-        };
-        let action = match e.kind {
-            EventType::Door => continue, // resolved above
-            EventType::Waypoints => {
-                if robot.navigation.is_some() {
-                    return c.err(
-                        &p.key("robot"),
-                        format!(
-                            "robot `{}` is driven by its tasks; a route event cannot apply",
-                            robot.name
-                        ),
-                    );
-                }
-                only("pose", e.pose.is_some(), "waypoints")?;
-                only("sensor", e.sensor.is_some(), "waypoints")?;
-                only("active", e.active.is_some(), "waypoints")?;
-                EventAction::Waypoints {
-                    points: points(&p, &e.points)?,
-                    looping: e.looping.unwrap_or(false),
-                }
-            }
-            EventType::Teleport => {
-                only("points", e.points.is_some(), "teleport")?;
-                only("loop", e.looping.is_some(), "teleport")?;
-                only("sensor", e.sensor.is_some(), "teleport")?;
-                only("active", e.active.is_some(), "teleport")?;
-                let Some(pose) = &e.pose else {
-                    return c.err(&p, "a teleport event needs `pose` ([x, y, yaw] or a place)");
-                };
-                let pose = point(&p.key("pose"), pose)?;
-                inside(&p.key("pose"), &pose)?;
-                if !grid.disc_is_clear(pose.x, pose.y, robot.footprint.bounding_radius()) {
-                    return c.err(
-                        &p.key("pose"),
-                        "the robot would be placed inside an obstacle",
-                    );
-                }
-                EventAction::Teleport(pose)
-            }
-            EventType::SensorFault => {
-                only("points", e.points.is_some(), "sensor_fault")?;
-                only("loop", e.looping.is_some(), "sensor_fault")?;
-                only("pose", e.pose.is_some(), "sensor_fault")?;
-                let Some(sensor) = e.sensor else {
-                    return c.err(
-                        &p,
-                        "a sensor_fault event needs `sensor` (laser, encoder or sonar)",
-                    );
-                };
-                let has = match sensor {
-                    SensorName::Laser => robot.laser.is_some(),
-                    SensorName::Encoder => robot.encoder.is_some(),
-                    SensorName::Sonar => robot.sonar.is_some(),
-                };
-                if !has {
-                    return c.err(
-                        &p.key("sensor"),
-                        format!("robot `{}` has no {sensor:?} sensor", robot.name).to_lowercase(),
-                    );
-                }
-                EventAction::SensorFault {
-                    sensor,
-                    active: e.active.unwrap_or(true),
-                }
-            }
-        };
-        events.push(Event {
-            at,
-            robot: e.robot.clone(),
-            action,
-        });
-    }
-    // stable: events at the same time fire in file order
-    events.sort_by(|a, b| a.at.total_cmp(&b.at));
+    let events = super::events::resolve_events(
+        &c,
+        &root.key("events"),
+        &f.events,
+        duration,
+        super::events::Known {
+            robots: &robots,
+            doors: &doors,
+            grid: &grid,
+        },
+        &point,
+        &inside,
+        &points,
+    )?;
     let people =
         super::people::resolve_people(&c, &root.key("people"), &f.people, &point, &inside, &grid)?;
 
@@ -728,96 +547,4 @@ pub fn default_diff_drive() -> DiffDrive {
         max_wheel_speed: 15.0,
         max_wheel_accel: 20.0,
     }
-}
-
-fn resolve_laser(c: &Checker, p: &KeyPath, l: &LaserFile) -> R<LaserSpec> {
-    let preset = l.preset.as_deref().unwrap_or("sick_lms100");
-    let Some(mut s) = LaserSpec::preset(preset) else {
-        return c.err(
-            &p.key("preset"),
-            format!(
-                "unknown laser preset `{preset}`; known: {}",
-                LaserSpec::PRESETS.join(", ")
-            ),
-        );
-    };
-    if let Some(v) = l.fov_deg {
-        s.fov = c
-            .range(&p.key("fov_deg"), v, Some(0.0), Some(360.0), true)?
-            .to_radians();
-    }
-    if let Some(v) = l.increment_deg {
-        s.increment = c
-            .range(&p.key("increment_deg"), v, Some(0.0), Some(90.0), true)?
-            .to_radians();
-    }
-    if s.beams() > 20_000 {
-        return c.err(
-            &p.key("increment_deg"),
-            format!("{} beams per scan is more than 20000", s.beams()),
-        );
-    }
-    if let Some(v) = l.min_range {
-        s.min_range = c.range(&p.key("min_range"), v, Some(0.0), None, false)?;
-    }
-    if let Some(v) = l.max_range {
-        s.max_range = c.range(&p.key("max_range"), v, Some(0.0), Some(1000.0), true)?;
-    }
-    if s.min_range >= s.max_range {
-        let key = if l.min_range.is_some() {
-            "min_range"
-        } else {
-            "max_range"
-        };
-        return c.err(
-            &p.key(key),
-            format!(
-                "min_range ({}) must be below max_range ({})",
-                s.min_range, s.max_range
-            ),
-        );
-    }
-    if let Some(v) = l.rate {
-        s.rate = c.range(&p.key("rate"), v, Some(0.0), Some(1000.0), true)?;
-    }
-    if let Some(v) = l.noise_std {
-        s.noise_std = c.range(&p.key("noise_std"), v, Some(0.0), Some(10.0), false)?;
-    }
-    if let Some(v) = l.dropout {
-        s.dropout = c.range(&p.key("dropout"), v, Some(0.0), Some(1.0), false)?;
-    }
-    if let Some(m) = l.mount {
-        c.finite(&p.key("mount"), &m)?;
-        s.mount = Pose2::new(m[0], m[1], m[2]);
-    }
-    Ok(s)
-}
-
-fn resolve_encoder(c: &Checker, p: &KeyPath, e: &EncoderFile) -> R<EncoderSpec> {
-    let mut s = EncoderSpec::default();
-    if let Some(t) = e.ticks_per_rev {
-        if t == 0 {
-            return c.err(
-                &p.key("ticks_per_rev"),
-                "expected at least 1 tick per revolution",
-            );
-        }
-        s.ticks_per_rev = t;
-    }
-    let rel = |key: &str, v: Option<f64>| -> R<f64> {
-        match v {
-            Some(v) => c.range(&p.key(key), v, Some(-0.5), Some(0.5), false),
-            None => Ok(0.0),
-        }
-    };
-    s.left_radius_error = rel("left_radius_error", e.left_radius_error)?;
-    s.right_radius_error = rel("right_radius_error", e.right_radius_error)?;
-    s.wheel_base_error = rel("wheel_base_error", e.wheel_base_error)?;
-    if let Some(v) = e.slip_std {
-        s.slip_std = c.range(&p.key("slip_std"), v, Some(0.0), Some(1.0), false)?;
-    }
-    if let Some(v) = e.rate {
-        s.rate = c.range(&p.key("rate"), v, Some(0.0), Some(10_000.0), true)?;
-    }
-    Ok(s)
 }

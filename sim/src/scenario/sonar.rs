@@ -83,32 +83,23 @@ fn resolve(c: &Checker, p: &KeyPath, footprint: &Footprint, f: &SonarFile) -> R<
             .range(&p.key("cone_deg"), v, Some(0.0), Some(180.0), true)?
             .to_radians();
     }
-    if let Some(v) = f.min_range {
-        s.min_range = c.range(&p.key("min_range"), v, Some(0.0), None, false)?;
+    super::sensors::RangeKeys {
+        min_range: f.min_range,
+        max_range: f.max_range,
+        rate: f.rate,
+        noise_std: f.noise_std,
     }
-    if let Some(v) = f.max_range {
-        s.max_range = c.range(&p.key("max_range"), v, Some(0.0), Some(100.0), true)?;
-    }
-    if s.min_range >= s.max_range {
-        let key = if f.min_range.is_some() {
-            "min_range"
-        } else {
-            "max_range"
-        };
-        return c.err(
-            &p.key(key),
-            format!(
-                "min_range ({}) must be below max_range ({})",
-                s.min_range, s.max_range
-            ),
-        );
-    }
-    if let Some(v) = f.rate {
-        s.rate = c.range(&p.key("rate"), v, Some(0.0), Some(1000.0), true)?;
-    }
-    if let Some(v) = f.noise_std {
-        s.noise_std = c.range(&p.key("noise_std"), v, Some(0.0), Some(10.0), false)?;
-    }
+    .apply(
+        c,
+        p,
+        [
+            &mut s.min_range,
+            &mut s.max_range,
+            &mut s.rate,
+            &mut s.noise_std,
+        ],
+        100.0,
+    )?;
     let mounts = match (&f.mounts, &f.layout) {
         (Some(_), Some(_)) => {
             return c.err(

@@ -58,7 +58,8 @@ pub struct DriveState {
     pub steer: f64,
 }
 
-fn approach(current: f64, target: f64, max_delta: f64) -> f64 {
+/// `current` moved towards `target` by at most `max_delta` (rate limits).
+pub(crate) fn approach(current: f64, target: f64, max_delta: f64) -> f64 {
     current + (target - current).clamp(-max_delta, max_delta)
 }
 

@@ -14,6 +14,7 @@
 //!
 //! A plain function over the path slice and a small state, so it is tested without the ECS.
 
+use crate::body::kinematics::approach;
 use crate::core::{Pose2, wrap_angle};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -151,10 +152,6 @@ fn point_along(path: &[[f64; 2]], seg: usize, t: f64, dist: f64) -> [f64; 2] {
 
 fn lerp(a: [f64; 2], b: [f64; 2], f: f64) -> [f64; 2] {
     [a[0] + (b[0] - a[0]) * f, a[1] + (b[1] - a[1]) * f]
-}
-
-fn approach(current: f64, target: f64, max_delta: f64) -> f64 {
-    current + (target - current).clamp(-max_delta, max_delta)
 }
 
 /// Speed change limited by the acceleration when speeding up and the braking limit when slowing.

@@ -21,9 +21,11 @@
 
 use super::astar::{PlanError, Planner, PlannerParams};
 use super::avoid::SectorRanges;
-use super::costmap::{Costmap, INSCRIBED, LETHAL};
+use super::costmap::{Costmap, INSCRIBED};
 use super::fleet::{Fleet, FleetActivity, FleetEntry, comes_through, gives_way, yield_spot};
 use super::follower::{FollowerParams, FollowerState, Steering, follow};
+use super::local_map::{along_band, mark_obstacles, nearest_free, path_blocked};
+use super::outcomes::{LegEvent, NavEvent, NavFailure, NavMetrics};
 use super::tasks::{Goal, Step, Task};
 use crate::body::DriveCommand;
 use crate::core::Pose2;
@@ -89,46 +91,6 @@ pub struct PlanRequest {
     pub goal: [f64; 2],
     /// Obstacle points (world frame) to plan around; empty for a plan on the shared costmap.
     pub around: Vec<[f64; 2]>,
-}
-
-/// One failed task.
-#[derive(Clone, Debug, PartialEq)]
-pub struct NavFailure {
-    pub time: f64,
-    pub task: String,
-    pub reason: String,
-}
-
-/// Navigation outcomes the robot itself knows (ground-truth ones are in `eval`).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct NavMetrics {
-    pub tasks_completed: u32,
-    pub tasks_failed: u32,
-    pub deliveries_completed: u32,
-    /// Duration of each completed delivery, from taking the task to the end of unloading (s).
-    pub delivery_times_s: Vec<f64>,
-    /// Stops for obstacles (each stop counted once, however long).
-    pub stops: u32,
-    /// Time spent stopped for obstacles or waiting aside for another robot (s).
-    pub waiting_time_s: f64,
-    pub replans: u32,
-    /// Times the robot stepped aside for another robot.
-    pub yields: u32,
-    pub failures: Vec<NavFailure>,
-}
-
-/// A navigation event for logs and the recording.
-#[derive(Clone, Debug, PartialEq)]
-pub struct NavEvent {
-    pub time: f64,
-    pub text: String,
-}
-
-/// A leg (one `Go` step) starting or ending, for the ground-truth evaluation.
-#[derive(Clone, Debug, PartialEq)]
-pub enum LegEvent {
-    Started { goal: [f64; 2] },
-    Finished { goal: [f64; 2], reached: bool },
 }
 
 #[derive(Component, Clone, Debug)]
@@ -711,108 +673,10 @@ impl Navigator {
     }
 }
 
-/// Arc length along `band` (a polyline) of the projection of `p`, if `p` lies within
-/// `half_width` of it (ahead of its start).
-fn along_band(band: &[[f64; 2]], p: [f64; 2], half_width: f64) -> Option<f64> {
-    let mut walked = 0.0;
-    let mut best: Option<f64> = None;
-    for w in band.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let len = dx.hypot(dy);
-        if len > 1e-9 {
-            let t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len;
-            let lateral = ((p[0] - a[0]) * dy - (p[1] - a[1]) * dx).abs() / len;
-            if t > 0.0 && t <= len && lateral < half_width {
-                let at = walked + t;
-                best = Some(best.map_or(at, |b: f64| b.min(at)));
-            }
-        }
-        walked += len;
-    }
-    best
-}
-
 /// Shared inputs of one control tick.
 pub struct ControlContext<'a> {
     pub now: f64,
     pub dt: f64,
     pub costmap: &'a Costmap,
     pub costmap_version: u64,
-}
-
-/// The centre of the nearest cell within `max_dist` of `p` that the robot may occupy.
-fn nearest_free(map: &Costmap, p: [f64; 2], max_dist: f64) -> Option<[f64; 2]> {
-    let (c0, r0) = map.cell_of(p[0], p[1])?;
-    let reach = (max_dist / map.resolution).ceil() as i64;
-    let mut best: Option<(i64, [f64; 2])> = None;
-    for dr in -reach..=reach {
-        for dc in -reach..=reach {
-            let d2 = dc * dc + dr * dr;
-            if d2 > reach * reach || best.is_some_and(|(b, _)| b <= d2) {
-                continue;
-            }
-            let (c, r) = (c0 as i64 + dc, r0 as i64 + dr);
-            if c < 0 || r < 0 || c >= map.width as i64 || r >= map.height as i64 {
-                continue;
-            }
-            if map.cost(c as usize, r as usize) < INSCRIBED {
-                best = Some((d2, map.cell_center(c as usize, r as usize)));
-            }
-        }
-    }
-    best.map(|(_, q)| q)
-}
-
-/// True if the path from segment `from` on crosses a cell the robot cannot occupy.
-pub fn path_blocked(map: &Costmap, path: &[[f64; 2]], from: usize) -> bool {
-    let start = from.min(path.len().saturating_sub(1));
-    path.get(start..)
-        .unwrap_or(&[])
-        .windows(2)
-        .any(|w| !super::shortcut::segment_clear(map, w[0], w[1], INSCRIBED - 1))
-}
-
-/// A copy of `map` with every obstacle point in free space (static cost below [`INSCRIBED`])
-/// marked lethal and inflated by `radius` (cells within it become [`INSCRIBED`]), so a plan keeps
-/// clear of what the robot sees. Points within `radius` of `robot` are skipped (the robot's own
-/// cell must stay free to plan from).
-pub fn mark_obstacles(map: &Costmap, points: &[[f64; 2]], radius: f64, robot: [f64; 2]) -> Costmap {
-    let mut out = map.clone();
-    let res = map.resolution;
-    let reach = (radius / res).ceil() as i64;
-    let r2 = (radius / res) * (radius / res);
-    for &p in points {
-        if (p[0] - robot[0]).hypot(p[1] - robot[1]) < radius {
-            continue;
-        }
-        let Some((c, r)) = map.cell_of(p[0], p[1]) else {
-            continue;
-        };
-        if map.cost(c, r) >= INSCRIBED {
-            continue; // a wall the map knows
-        }
-        out.costs[map.index(c, r)] = LETHAL;
-        for dr in -reach..=reach {
-            for dc in -reach..=reach {
-                if (dc * dc + dr * dr) as f64 > r2 {
-                    continue;
-                }
-                let (nc, nr) = (c as i64 + dc, r as i64 + dr);
-                if nc < 0 || nr < 0 || nc >= map.width as i64 || nr >= map.height as i64 {
-                    continue;
-                }
-                let i = map.index(nc as usize, nr as usize);
-                if out.costs[i] < INSCRIBED {
-                    out.costs[i] = INSCRIBED;
-                }
-            }
-        }
-    }
-    // never wall the robot in: its own cell stays as it was
-    if let Some((c, r)) = map.cell_of(robot[0], robot[1]) {
-        let i = map.index(c, r);
-        out.costs[i] = map.costs[i];
-    }
-    out
 }

@@ -1,0 +1,69 @@
+//! The places file beside a map (the ROS map YAML has no room for them): named poses
+//! (`[places.<name>] pose = [x, y, yaw]`) and doors (`[doors.<name>] from, to, thickness`), with
+//! errors naming the places file and key.
+
+use super::DoorConfig;
+use super::error::{ErrorContext, KeyPath};
+use super::file::PlacesFile;
+use super::resolve::{Checker, R};
+use std::collections::BTreeMap;
+use std::path::Path;
+use systems::core::Pose2;
+use systems::world::OccupancyGrid;
+
+/// Reads `ppath` (named by `key` of the scenario): its places and doors.
+pub(super) fn load_places(
+    c: &Checker,
+    key: &KeyPath,
+    ppath: &Path,
+    grid: &OccupancyGrid,
+) -> R<(BTreeMap<String, Pose2>, Vec<DoorConfig>)> {
+    let mut places = BTreeMap::new();
+    let mut doors = Vec::new();
+    let ptext = std::fs::read_to_string(ppath).map_err(|e| {
+        c.cx.at(key, format!("cannot read {}: {e}", ppath.display()))
+    })?;
+    let pcx = ErrorContext::new(ppath.display().to_string(), &ptext);
+    let parsed: PlacesFile = toml::from_str(&ptext).map_err(|e| pcx.from_toml(&e))?;
+    for (name, place) in parsed.places {
+        let pp = KeyPath::default().key("places").key(&name).key("pose");
+        if place.pose.iter().any(|v| !v.is_finite()) {
+            return Err(pcx.at(&pp, "expected [x, y, yaw] finite numbers"));
+        }
+        places.insert(
+            name,
+            Pose2::new(place.pose[0], place.pose[1], place.pose[2]),
+        );
+    }
+    for (name, d) in parsed.doors {
+        let dp = KeyPath::default().key("doors").key(&name);
+        let b = grid.bounds();
+        for (key, v) in [("from", d.from), ("to", d.to)] {
+            if v.iter().any(|x| !x.is_finite())
+                || v[0] < b[0]
+                || v[1] < b[1]
+                || v[0] > b[2]
+                || v[1] > b[3]
+            {
+                return Err(pcx.at(
+                    &dp.key(key),
+                    format!("expected a finite [x, y] inside the map, got {v:?}"),
+                ));
+            }
+        }
+        let thickness = d.thickness.unwrap_or(0.15);
+        if !(thickness > 0.0 && thickness <= 2.0) {
+            return Err(pcx.at(
+                &dp.key("thickness"),
+                format!("expected a number in (0, 2] m, got {thickness}"),
+            ));
+        }
+        doors.push(DoorConfig {
+            name,
+            from: d.from,
+            to: d.to,
+            thickness,
+        });
+    }
+    Ok((places, doors))
+}
