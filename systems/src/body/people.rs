@@ -28,6 +28,8 @@ pub const DEFAULT_RADIUS: f64 = 0.25;
 pub const SLOW_GAP: f64 = 1.2;
 /// …and below which it stands still until the way clears.
 pub const STOP_GAP: f64 = 0.6;
+/// Within this surface gap (m) a person does not move any closer to someone (see [`keep_clear`]).
+pub const PERSONAL_SPACE: f64 = 0.2;
 /// Someone counts as "in the way" when their centre is within both radii plus this of the
 /// walking line (m).
 const LANE_MARGIN: f64 = 0.15;
@@ -217,7 +219,7 @@ pub fn plan_walk(
     // land on the point rather than overshoot it
     let speed = walker.leg_speed.min(dist / dt);
     let Some(gap) = gap_ahead(p, r, d, others).filter(|g| *g < SLOW_GAP) else {
-        walker.velocity = [d[0] * speed, d[1] * speed];
+        walker.velocity = keep_clear(p, r, [d[0] * speed, d[1] * speed], others);
         return;
     };
     // someone is in the way: slow down (to a stop at STOP_GAP) and step aside meanwhile
@@ -230,7 +232,26 @@ pub fn plan_walk(
     });
     let side_speed = SIDESTEP * walker.leg_speed;
     let (sx, sy) = side.map_or((0.0, 0.0), |s| (s[0] * side_speed, s[1] * side_speed));
-    walker.velocity = [d[0] * speed * f + sx, d[1] * speed * f + sy];
+    walker.velocity = keep_clear(p, r, [d[0] * speed * f + sx, d[1] * speed * f + sy], others);
+}
+
+/// `v` without the part that would take a person at `p` (radius `r`) closer to anyone already
+/// within [`PERSONAL_SPACE`] of it: nobody walks into someone beside them, whatever their route
+/// says (the repulsive term of the social force model, reduced to a hard constraint).
+fn keep_clear(p: [f64; 2], r: f64, mut v: [f64; 2], others: &[Agent]) -> [f64; 2] {
+    for o in others {
+        let (rx, ry) = (o.x - p[0], o.y - p[1]);
+        let d = rx.hypot(ry);
+        if d < 1e-9 || d - r - o.radius >= PERSONAL_SPACE {
+            continue;
+        }
+        let u = [rx / d, ry / d];
+        let towards = v[0] * u[0] + v[1] * u[1];
+        if towards > 0.0 {
+            v = [v[0] - towards * u[0], v[1] - towards * u[1]];
+        }
+    }
+    v
 }
 
 /// Control: every person plans this step's velocity from last step's ground truth.
@@ -332,6 +353,38 @@ mod tests {
         let path = walk(&person, &[], &grid, 300);
         let last = path[300];
         assert!(last[1].abs() < ARRIVE_TOL && last[0] > 0.5, "{last:?}");
+    }
+
+    #[test]
+    fn never_walks_into_someone_beside_it() {
+        // a robot just beside the route (surface gap 0.1 m): the person may pass it but never
+        // closes the gap, while walking on at full speed along the route
+        let person = Person {
+            looping: false,
+            ..Person::new(vec![[-3.0, 0.0], [3.0, 0.0]])
+        };
+        let me = [0.0, 0.0];
+        let robot = Agent {
+            x: 0.1,
+            y: 0.65,
+            radius: 0.3,
+        };
+        // heading straight at it: nothing of the velocity is left towards it
+        let v = keep_clear(me, 0.25, [0.3, 1.0], &[robot]);
+        let towards = v[0] * 0.1 + v[1] * 0.65;
+        assert!(towards.abs() < 1e-9, "{v:?}");
+        // heading away or past it: untouched
+        assert_eq!(keep_clear(me, 0.25, [0.0, -1.0], &[robot]), [0.0, -1.0]);
+        let beside = Agent { x: 0.0, ..robot };
+        assert_eq!(keep_clear(me, 0.25, [1.2, 0.0], &[beside]), [1.2, 0.0]);
+        // over a whole walk past it: no contact, and the person gets by
+        let path = walk(&person, &[robot], &open_floor(), 200);
+        let min_gap = path
+            .iter()
+            .map(|q| (robot.x - q[0]).hypot(robot.y - q[1]) - 0.55)
+            .fold(f64::INFINITY, f64::min);
+        assert!(min_gap > 0.05, "{min_gap}");
+        assert!(path[200][0] > 2.0, "{:?}", path[200]);
     }
 
     #[test]

@@ -5,6 +5,7 @@
 
 use super::avoid::SectorRanges;
 use super::fleet::Fleet;
+use super::local_map::echo_explained;
 use super::navigator::{ControlContext, Navigator};
 use super::shared_costmaps::NavCostmaps;
 use crate::body::DriveCommand;
@@ -13,6 +14,13 @@ use crate::localization::NavBelief;
 use crate::sensors::{Laser, LaserScans, SonarReadings, Sonars};
 use bevy_ecs::prelude::*;
 use rayon::prelude::*;
+
+/// A sonar echo within this distance (m) of a wall the map knows in its cone is that wall (range
+/// noise, belief error, the wall's cell size).
+const ECHO_TOLERANCE: f64 = 0.25;
+/// …and a wall this far (rad) outside either edge of the cone may be what it heard (heading error
+/// of the belief, the map's cells against the true outline of a door frame's corner).
+const ECHO_CONE_MARGIN: f64 = 0.15;
 
 /// Plan: answer every pending plan request from the robot's belief.
 pub fn plan_routes(
@@ -81,6 +89,7 @@ pub fn drive_navigators(
                 // sonar echoes join the laser points of the stop check (the laser is blind
                 // behind and below its plane; the sonars cover front, ±45° and rear)
                 nav.extra.clear();
+                let costmap = costmaps.get(nav.params.costmap);
                 if let Some((sonars, readings)) = sonar
                     && sonars.enabled
                 {
@@ -90,8 +99,20 @@ pub fn drive_navigators(
                         } else {
                             r
                         };
-                        if r.is_finite() {
-                            // the echo is somewhere in the cone at that range: an arc of points
+                        let sensor = belief.pose.compose(m);
+                        let explained = |r: f32| {
+                            echo_explained(
+                                costmap,
+                                &sensor,
+                                sonars.spec.cone + 2.0 * ECHO_CONE_MARGIN,
+                                sonars.spec.fan_rays() + 4,
+                                r as f64,
+                                ECHO_TOLERANCE,
+                            )
+                        };
+                        if r.is_finite() && !explained(r) {
+                            // an echo short of every wall the map knows in the cone: something is
+                            // somewhere in the cone at that range, an arc of points
                             let half = sonars.spec.cone / 2.0;
                             for k in 0..7 {
                                 let a = -half + half * k as f64 / 3.0;
@@ -112,7 +133,7 @@ pub fn drive_navigators(
                 let ctx = ControlContext {
                     now,
                     dt,
-                    costmap: costmaps.get(nav.params.costmap),
+                    costmap,
                     costmap_version: costmaps.version,
                 };
                 **cmd = nav.control(&ctx, idx.0, &belief.pose, fleet);

@@ -299,6 +299,65 @@ fn brake(
     }
 }
 
+/// The point pure pursuit steers for: the look-ahead distance at speed `v` along `path` (≥ 2
+/// points) from the robot's projection on segment `seg`.
+pub fn lookahead_point(
+    path: &[[f64; 2]],
+    seg: usize,
+    pose: &Pose2,
+    p: &FollowerParams,
+    v: f64,
+) -> [f64; 2] {
+    let seg = seg.min(path.len() - 2);
+    let (t, _) = project(path[seg], path[seg + 1], [pose.x, pose.y]);
+    point_along(path, seg, t, p.lookahead + p.lookahead_time * v.abs())
+}
+
+/// The arc pure pursuit drives from `pose` towards the look-ahead point on `path` (≥ 2 points,
+/// from segment `seg` on, at speed `v`): `n` + 1 points from the robot to the look-ahead point
+/// along the circle tangent to the heading (Coulter 1992, eq. of the curvature 2·y / L²). Empty
+/// when the point lies too far to the side to be driven to directly (a diff-drive robot turns
+/// on the spot first).
+pub fn pursuit_arc(
+    path: &[[f64; 2]],
+    seg: usize,
+    pose: &Pose2,
+    p: &FollowerParams,
+    v: f64,
+    n: usize,
+) -> Vec<[f64; 2]> {
+    if path.len() < 2 || n == 0 {
+        return Vec::new();
+    }
+    let target = lookahead_point(path, seg, pose, p, v);
+    let (s, c) = pose.theta.sin_cos();
+    let (dx, dy) = (target[0] - pose.x, target[1] - pose.y);
+    let (lx, ly) = (c * dx + s * dy, -s * dx + c * dy);
+    let bearing = ly.atan2(lx);
+    if bearing.abs() > p.rotate_threshold.min(std::f64::consts::FRAC_PI_2) {
+        return Vec::new();
+    }
+    let l2 = lx * lx + ly * ly;
+    let kappa = 2.0 * ly / l2.max(1e-9);
+    // arc length to the point: the swept angle is twice the bearing
+    let len = if kappa.abs() < 1e-6 {
+        l2.sqrt()
+    } else {
+        2.0 * bearing / kappa
+    };
+    (0..=n)
+        .map(|i| {
+            let a = len * i as f64 / n as f64;
+            let (x, y) = if kappa.abs() < 1e-6 {
+                (a, 0.0)
+            } else {
+                ((kappa * a).sin() / kappa, (1.0 - (kappa * a).cos()) / kappa)
+            };
+            [pose.x + c * x - s * y, pose.y + s * x + c * y]
+        })
+        .collect()
+}
+
 /// Angle between the robot's heading and the direction to `p` (rad).
 pub fn bearing_to(pose: &Pose2, p: [f64; 2]) -> f64 {
     wrap_angle((p[1] - pose.y).atan2(p[0] - pose.x) - pose.theta)

@@ -1,8 +1,10 @@
 //! What the navigator asks of the costmap and of what its sensors see: the distance along the
 //! band the path sweeps to an obstacle point, whether a path still fits the costmap, the nearest
-//! cell the robot may occupy, and a costmap copy with seen obstacles marked for planning around.
+//! cell the robot may occupy, whether a sonar echo is just a wall the map knows, and a costmap
+//! copy with seen obstacles marked for planning around.
 
 use super::costmap::{Costmap, INSCRIBED, LETHAL};
+use crate::core::Pose2;
 
 /// Arc length along `band` (a polyline) of the projection of `p`, if `p` lies within
 /// `half_width` of it (ahead of its start).
@@ -24,6 +26,40 @@ pub(crate) fn along_band(band: &[[f64; 2]], p: [f64; 2], half_width: f64) -> Opt
         walked += len;
     }
     best
+}
+
+/// True if a sonar echo at `range` (m) from `sensor` (world pose of the transducer, on the
+/// belief) is explained by the map: some ray of a fan of `rays` across the `cone` (rad) meets a
+/// lethal cell within `range + tolerance`. A sonar only reports its nearest echo somewhere in a
+/// wide cone, so an echo the map explains (a door frame beside the robot, the wall at the end of
+/// a corridor) says nothing about unknown obstacles; one clearly short of every known wall does.
+/// This is the map-consistency test of sonar readings in Thrun, Burgard & Fox, "Probabilistic
+/// Robotics" (2005), §6.3 (expected range from the map), reduced to a yes/no per echo.
+pub(crate) fn echo_explained(
+    map: &Costmap,
+    sensor: &Pose2,
+    cone: f64,
+    rays: usize,
+    range: f64,
+    tolerance: f64,
+) -> bool {
+    let reach = range + tolerance;
+    let step = map.resolution * 0.5;
+    let n = rays.max(2);
+    (0..n).any(|k| {
+        let a = sensor.theta - cone / 2.0 + cone * k as f64 / (n - 1) as f64;
+        let (s, c) = a.sin_cos();
+        let mut d = 0.0;
+        while d <= reach {
+            match map.cell_of(sensor.x + c * d, sensor.y + s * d) {
+                Some((col, row)) if map.cost(col, row) >= LETHAL => return true,
+                Some(_) => {}
+                None => return true, // off the map: the map's edge is a wall
+            }
+            d += step;
+        }
+        false
+    })
 }
 
 /// The centre of the nearest cell within `max_dist` of `p` that the robot may occupy.
@@ -59,16 +95,25 @@ pub fn path_blocked(map: &Costmap, path: &[[f64; 2]], from: usize) -> bool {
 }
 
 /// A copy of `map` with every obstacle point in free space (static cost below [`INSCRIBED`])
-/// marked lethal and inflated by `radius` (cells within it become [`INSCRIBED`]), so a plan keeps
-/// clear of what the robot sees. Points within `radius` of `robot` are skipped (the robot's own
-/// cell must stay free to plan from).
-pub fn mark_obstacles(map: &Costmap, points: &[[f64; 2]], radius: f64, robot: [f64; 2]) -> Costmap {
+/// marked lethal and inflated: cells within `hard` of a point become [`INSCRIBED`] (the robot's
+/// centre may not go there), cells between `hard` and `soft` get a cost falling linearly from
+/// [`BERTH_COST`] to half of it, so a plan keeps a wide berth of what the robot sees (people walk
+/// on, doors swing) where the corridor has room and squeezes past at `hard` where it has not.
+/// Points within `hard` of `robot` are skipped (the robot's own cell must stay free to plan from).
+pub fn mark_obstacles(
+    map: &Costmap,
+    points: &[[f64; 2]],
+    hard: f64,
+    soft: f64,
+    robot: [f64; 2],
+) -> Costmap {
     let mut out = map.clone();
     let res = map.resolution;
-    let reach = (radius / res).ceil() as i64;
-    let r2 = (radius / res) * (radius / res);
+    let soft = soft.max(hard);
+    let reach = (soft / res).ceil() as i64;
+    let (hard2, soft2) = ((hard / res).powi(2), (soft / res).powi(2));
     for &p in points {
-        if (p[0] - robot[0]).hypot(p[1] - robot[1]) < radius {
+        if (p[0] - robot[0]).hypot(p[1] - robot[1]) < hard {
             continue;
         }
         let Some((c, r)) = map.cell_of(p[0], p[1]) else {
@@ -80,16 +125,23 @@ pub fn mark_obstacles(map: &Costmap, points: &[[f64; 2]], radius: f64, robot: [f
         out.costs[map.index(c, r)] = LETHAL;
         for dr in -reach..=reach {
             for dc in -reach..=reach {
-                if (dc * dc + dr * dr) as f64 > r2 {
+                let d2 = (dc * dc + dr * dr) as f64;
+                if d2 > soft2 {
                     continue;
                 }
                 let (nc, nr) = (c as i64 + dc, r as i64 + dr);
                 if nc < 0 || nr < 0 || nc >= map.width as i64 || nr >= map.height as i64 {
                     continue;
                 }
+                let cost = if d2 <= hard2 {
+                    INSCRIBED
+                } else {
+                    let f = (d2.sqrt() * res - hard) / (soft - hard);
+                    (BERTH_COST as f64 * (1.0 - 0.5 * f)).round() as u8
+                };
                 let i = map.index(nc as usize, nr as usize);
-                if out.costs[i] < INSCRIBED {
-                    out.costs[i] = INSCRIBED;
+                if out.costs[i] < cost {
+                    out.costs[i] = cost;
                 }
             }
         }
@@ -101,3 +153,6 @@ pub fn mark_obstacles(map: &Costmap, points: &[[f64; 2]], radius: f64, robot: [f
     }
     out
 }
+
+/// Cost of the cells just outside the hard margin round a seen obstacle (see [`mark_obstacles`]).
+pub const BERTH_COST: u8 = 200;

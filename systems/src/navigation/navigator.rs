@@ -23,7 +23,9 @@ use super::astar::{PlanError, Planner, PlannerParams};
 use super::avoid::SectorRanges;
 use super::costmap::{Costmap, INSCRIBED};
 use super::fleet::{Fleet, FleetActivity, FleetEntry, comes_through, gives_way, yield_spot};
-use super::follower::{FollowerParams, FollowerState, Steering, follow};
+use super::follower::{
+    FollowerParams, FollowerState, Steering, follow, lookahead_point, pursuit_arc,
+};
 use super::local_map::{along_band, mark_obstacles, nearest_free, path_blocked};
 use super::outcomes::{LegEvent, NavEvent, NavFailure, NavMetrics};
 use super::tasks::{Goal, Step, Task};
@@ -121,7 +123,53 @@ pub struct Navigator {
     pub(crate) seen: Option<SectorRanges>,
     /// Extra obstacle points in the base frame (sonar echoes), refreshed every tick.
     pub(crate) extra: Vec<(f32, f32)>,
+    /// While blocked: since when the way has looked clear.
+    clear_since: Option<f64>,
+    /// The last stop the robot went on from, to tell a flickering obstacle from a new one.
+    resumed: Option<Resumed>,
+    /// Long ways round refused in a row while blocked (see [`DETOUR_FACTOR`]).
+    detours_refused: u32,
+    /// Since when the robot has been held by an obstacle on its way aside.
+    held_since: Option<f64>,
 }
+
+/// Shortest look-ahead (m) [`Navigator::safe_lookahead`] falls back to.
+const MIN_LOOKAHEAD: f64 = 0.15;
+
+/// A plan around an obstacle longer than this many times the rest of the current path (plus
+/// [`DETOUR_SLACK`] m) is refused up to [`MAX_DETOUR_REFUSALS`] times in a row, one `wait_time`
+/// apart: a person standing in a cross corridor should not send the robot round the building.
+const DETOUR_FACTOR: f64 = 1.5;
+const DETOUR_SLACK: f64 = 10.0;
+const MAX_DETOUR_REFUSALS: u32 = 3;
+
+/// Length (m) of `path` from `from` (a point near segment `seg`) to its end.
+fn remaining_length(path: &[[f64; 2]], seg: usize, from: &Pose2) -> f64 {
+    let Some(next) = path.get(seg + 1) else {
+        return 0.0;
+    };
+    let rest: f64 = path[seg + 1..]
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    (next[0] - from.x).hypot(next[1] - from.y) + rest
+}
+
+/// A stop the robot went on from: when it began, where, and when the robot went on.
+#[derive(Clone, Copy, Debug)]
+struct Resumed {
+    since: f64,
+    at: [f64; 2],
+    time: f64,
+}
+
+/// The way must look clear this long (s) before a stopped robot goes on: one clear reading of a
+/// noisy sensor is not enough.
+const CLEAR_TIME: f64 = 0.5;
+/// Stopping again within this time (s) and distance (m) of going on continues the same stop
+/// (same start of waiting, not counted again).
+const SAME_STOP_TIME: f64 = 3.0;
+const SAME_STOP_DIST: f64 = 0.5;
 
 impl Navigator {
     pub fn new(params: NavParams, tasks: Vec<Task>) -> Self {
@@ -147,6 +195,10 @@ impl Navigator {
             costmap_version: 0,
             seen: None,
             extra: Vec::new(),
+            clear_since: None,
+            resumed: None,
+            detours_refused: 0,
+            held_since: None,
         }
     }
 
@@ -306,9 +358,10 @@ impl Navigator {
         let marked;
         let map = if around {
             // keep the stop band (radius + 5 cm) and a margin off what was seen, so the new
-            // path does not stop the robot again at once
-            let keep_off = self.params.radius + 0.15;
-            marked = mark_obstacles(map, &req.around, keep_off, [from.x, from.y]);
+            // path does not stop the robot again at once, and a wider berth where there is room
+            // (what was seen may be a person who moves)
+            let r = self.params.radius;
+            marked = mark_obstacles(map, &req.around, r + 0.15, r + 0.5, [from.x, from.y]);
             &marked
         } else {
             map
@@ -324,8 +377,31 @@ impl Navigator {
                 p
             });
         }
+        if around
+            && let Ok(p) = &result
+            && self.detours_refused < MAX_DETOUR_REFUSALS
+        {
+            let remaining = remaining_length(&self.path, self.follower.segment, from);
+            if p.length > DETOUR_FACTOR * remaining + DETOUR_SLACK {
+                // what blocks the way is probably a person who will walk on: wait a while
+                // longer before taking a long way round
+                self.detours_refused += 1;
+                self.log(
+                    now,
+                    format!(
+                        "the way around is {:.0} m against {remaining:.0} m: waiting",
+                        p.length
+                    ),
+                );
+                if let Phase::Blocked { since } = &mut self.phase {
+                    *since = now;
+                }
+                return;
+            }
+        }
         match result {
             Ok(p) => {
+                self.detours_refused = 0;
                 self.set_path(p.waypoints);
                 if matches!(self.phase, Phase::Planning | Phase::Blocked { .. }) {
                     self.phase = Phase::Driving;
@@ -403,6 +479,7 @@ impl Navigator {
                     fp.lookahead = 0.2;
                     fp.lookahead_time = 0.0;
                 }
+                let fp = self.safe_lookahead(pose, ctx.costmap, fp);
                 let out = follow(
                     &self.path,
                     pose,
@@ -433,18 +510,17 @@ impl Navigator {
                     }
                     return DriveCommand { v: out.v, w: out.w };
                 }
-                if room <= 0.0 && out.v <= 1e-3 && out.w.abs() < 0.3 && self.wants_forward(pose) {
-                    self.metrics.stops += 1;
-                    self.log(
-                        now,
-                        format!(
-                            "stop at ({:.2}, {:.2}): obstacle {gap:.2} m ahead",
-                            pose.x, pose.y
-                        ),
-                    );
-                    if matches!(self.phase, Phase::Driving) {
-                        self.phase = Phase::Blocked { since: now };
+                // held by the obstacle: not moving forward and not turning on the spot (or not
+                // moving at all)
+                let held = self.wants_forward(pose) || out.w.abs() < 1e-3;
+                if room <= 0.0 && out.v <= 1e-3 && out.w.abs() < 0.3 && held {
+                    if let Phase::Yielding { for_robot, .. } = self.phase {
+                        self.held_on_the_way_aside(now, pose, gap, for_robot);
+                    } else {
+                        self.stopped(now, pose, gap);
                     }
+                } else if out.v > 0.05 {
+                    self.held_since = None;
                 }
                 if out.off_path > 1.5
                     && matches!(self.phase, Phase::Driving)
@@ -463,9 +539,21 @@ impl Navigator {
             Phase::Blocked { since } => {
                 self.metrics.waiting_time_s += ctx.dt;
                 if gap - p.stop_distance > 0.1 {
-                    self.phase = Phase::Driving;
-                    self.log(now, "way clear: going on");
-                    return self.brake(ctx.dt);
+                    let clear = *self.clear_since.get_or_insert(now);
+                    if now - clear >= CLEAR_TIME - 1e-9 {
+                        self.phase = Phase::Driving;
+                        self.clear_since = None;
+                        self.resumed = Some(Resumed {
+                            since,
+                            at: [pose.x, pose.y],
+                            time: now,
+                        });
+                        self.detours_refused = 0;
+                        self.log(now, "way clear: going on");
+                        return self.brake(ctx.dt);
+                    }
+                } else {
+                    self.clear_since = None;
                 }
                 self.settle_block(ctx, index, pose, fleet, since);
                 self.brake(ctx.dt)
@@ -486,6 +574,59 @@ impl Navigator {
                 }
                 self.brake(ctx.dt)
             }
+        }
+    }
+
+    /// Driving and stopped by an obstacle: block (continuing the last stop if the robot went on
+    /// from it only just now and nearby).
+    fn stopped(&mut self, now: f64, pose: &Pose2, gap: f64) {
+        let same = self.resumed.take().filter(|r| {
+            now - r.time < SAME_STOP_TIME
+                && (pose.x - r.at[0]).hypot(pose.y - r.at[1]) < SAME_STOP_DIST
+        });
+        let since = match same {
+            Some(r) => r.since,
+            None => {
+                self.metrics.stops += 1;
+                self.log(
+                    now,
+                    format!(
+                        "stop at ({:.2}, {:.2}): obstacle {gap:.2} m ahead",
+                        pose.x, pose.y
+                    ),
+                );
+                now
+            }
+        };
+        self.phase = Phase::Blocked { since };
+        self.clear_since = None;
+    }
+
+    /// On the way to a spot to give way and stopped by an obstacle: one stop, and after
+    /// `wait_time` the robot waits where it is instead (the other robot plans around it).
+    fn held_on_the_way_aside(&mut self, now: f64, pose: &Pose2, gap: f64, for_robot: u32) {
+        match self.held_since {
+            None => {
+                self.held_since = Some(now);
+                self.metrics.stops += 1;
+                self.log(
+                    now,
+                    format!(
+                        "stop at ({:.2}, {:.2}) on the way aside: obstacle {gap:.2} m ahead",
+                        pose.x, pose.y
+                    ),
+                );
+            }
+            Some(since) if now - since >= self.params.wait_time => {
+                self.held_since = None;
+                self.phase = Phase::Yielding {
+                    for_robot,
+                    since: now,
+                    parked: true,
+                };
+                self.log(now, "cannot get aside: waiting here");
+            }
+            Some(_) => {}
         }
     }
 
@@ -545,6 +686,7 @@ impl Navigator {
                             self.set_path(path);
                             self.metrics.yields += 1;
                             self.cannot_yield = false;
+                            self.held_since = None;
                             self.phase = Phase::Yielding {
                                 for_robot: o,
                                 since: now,
@@ -618,6 +760,13 @@ impl Navigator {
                 break;
             }
         }
+        // and the arc pure pursuit actually drives to its look-ahead point, which cuts inside
+        // the path's corners
+        let fp = &self.params.follower;
+        let arc = match self.params.steering {
+            Steering::DiffDrive => pursuit_arc(&self.path, self.follower.segment, pose, fp, v, 6),
+            Steering::Ackermann { .. } => Vec::new(),
+        };
         let mut free = f64::INFINITY;
         for &(x, y) in pts {
             let w = pose.transform_point([x as f64, y as f64]);
@@ -632,26 +781,71 @@ impl Navigator {
             if let Some(along) = along_band(&band, w, hw) {
                 free = free.min(along);
             }
+            if let Some(along) = along_band(&arc, w, hw) {
+                free = free.min(along);
+            }
         }
         free - r
     }
 
-    /// True if the path leads forward from here (not a turn on the spot).
-    fn wants_forward(&self, pose: &Pose2) -> bool {
-        let i = (self.follower.segment + 1).min(self.path.len().saturating_sub(1));
-        self.path.get(i).is_some_and(|&q| {
-            super::follower::bearing_to(pose, q).abs() < self.params.follower.rotate_threshold
-        })
+    /// `fp` with the look-ahead shortened (halved down to [`MIN_LOOKAHEAD`]) until the arc pure
+    /// pursuit would drive to its look-ahead point keeps the robot's centre out of the inscribed
+    /// cells of the costmap: near walls (a doorway entered at an angle) the robot tracks the path
+    /// closely instead of cutting the corner into the frame. The collision check of the
+    /// look-ahead arc of Macenski et al., "Regulated Pure Pursuit for Robot Path Tracking",
+    /// Autonomous Robots 47 (2023), §3.3, reduced to choosing the look-ahead.
+    fn safe_lookahead(
+        &self,
+        pose: &Pose2,
+        map: &Costmap,
+        mut fp: FollowerParams,
+    ) -> FollowerParams {
+        if self.path.len() < 2 {
+            return fp;
+        }
+        let v = self.follower.v;
+        let mut lookahead = fp.lookahead + fp.lookahead_time * v.abs();
+        loop {
+            let mut trial = fp;
+            trial.lookahead = lookahead;
+            trial.lookahead_time = 0.0;
+            let n = ((lookahead * 1.6) / (0.5 * map.resolution)).ceil().max(2.0) as usize;
+            let arc = pursuit_arc(&self.path, self.follower.segment, pose, &trial, v, n);
+            // (the robot's own cell may already be inscribed when squeezed through a doorway)
+            let clear = arc.iter().skip(1).all(|q| {
+                map.cell_of(q[0], q[1])
+                    .is_some_and(|(c, r)| map.cost(c, r) < INSCRIBED)
+            });
+            if clear || lookahead <= MIN_LOOKAHEAD {
+                if lookahead < fp.lookahead + fp.lookahead_time * v.abs() {
+                    fp = trial;
+                }
+                return fp;
+            }
+            lookahead = (lookahead * 0.5).max(MIN_LOOKAHEAD);
+        }
     }
 
-    /// Seen obstacle points within 4 m, in the world frame of the belief.
+    /// True if the follower steers forward from here (its look-ahead point is within the
+    /// rotate threshold, so it is not turning on the spot).
+    fn wants_forward(&self, pose: &Pose2) -> bool {
+        if self.path.len() < 2 {
+            return false;
+        }
+        let fp = &self.params.follower;
+        let q = lookahead_point(&self.path, self.follower.segment, pose, fp, self.follower.v);
+        super::follower::bearing_to(pose, q).abs() < fp.rotate_threshold
+    }
+
+    /// Seen obstacle points within 4 m, in the world frame of the belief, to plan around: the
+    /// laser's when there is one (a sonar echo only says "somewhere in a 55° cone", and marking
+    /// the whole arc would close a corridor), else the sonars'.
     fn obstacles_world(&self, pose: &Pose2) -> Vec<[f64; 2]> {
         let mut out = Vec::new();
-        let pts = self
-            .seen
-            .iter()
-            .flat_map(|s| s.points.iter())
-            .chain(self.extra.iter());
+        let pts: Box<dyn Iterator<Item = &(f32, f32)>> = match &self.seen {
+            Some(s) => Box::new(s.points.iter()),
+            None => Box::new(self.extra.iter()),
+        };
         for &(x, y) in pts {
             let (x, y) = (x as f64, y as f64);
             if x * x + y * y <= 16.0 {
