@@ -28,7 +28,7 @@ pub const DEFAULT_RADIUS: f64 = 0.25;
 pub const SLOW_GAP: f64 = 1.2;
 /// …and below which it stands still until the way clears.
 pub const STOP_GAP: f64 = 0.6;
-/// Within this surface gap (m) a person does not move any closer to someone (see [`keep_clear`]).
+/// Within this surface gap (m) a person does not move any closer to someone.
 pub const PERSONAL_SPACE: f64 = 0.2;
 /// Someone counts as "in the way" when their centre is within both radii plus this of the
 /// walking line (m).

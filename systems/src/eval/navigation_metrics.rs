@@ -56,10 +56,15 @@ pub fn evaluate_navigation(
     for (mut nav, truth, metrics, mut out) in robots.iter_mut() {
         let c = metrics.collisions;
         if c != out.seen_collisions {
-            let what = if c.wall > out.seen_collisions.wall {
+            let seen = out.seen_collisions;
+            let what = if c.wall > seen.wall {
                 "collision with a wall"
+            } else if c.robot > seen.robot {
+                "collision with another robot"
+            } else if c.person > seen.person {
+                "collision with a person"
             } else {
-                "collision with another body"
+                "collision"
             };
             let p = truth.pose;
             out.collision_log

@@ -19,14 +19,17 @@
 //! reason instead of retrying forever. A door closing across the current path (the shared
 //! costmap changes) triggers a re-plan.
 
+mod blocking;
+mod clearance;
+
+use blocking::{CLEAR_TIME, Resumed};
+
 use super::astar::{PlanError, Planner, PlannerParams};
 use super::avoid::SectorRanges;
-use super::costmap::{Costmap, INSCRIBED};
-use super::fleet::{Fleet, FleetActivity, FleetEntry, comes_through, gives_way, yield_spot};
-use super::follower::{
-    FollowerParams, FollowerState, Steering, follow, lookahead_point, pursuit_arc,
-};
-use super::local_map::{along_band, mark_obstacles, nearest_free, path_blocked};
+use super::costmap::Costmap;
+use super::fleet::{Fleet, FleetActivity, FleetEntry, comes_through};
+use super::follower::{FollowerParams, FollowerState, Steering, follow};
+use super::local_map::{mark_obstacles, nearest_free, path_blocked};
 use super::outcomes::{LegEvent, NavEvent, NavFailure, NavMetrics};
 use super::tasks::{Goal, Step, Task};
 use crate::body::DriveCommand;
@@ -133,9 +136,6 @@ pub struct Navigator {
     held_since: Option<f64>,
 }
 
-/// Shortest look-ahead (m) [`Navigator::safe_lookahead`] falls back to.
-const MIN_LOOKAHEAD: f64 = 0.15;
-
 /// A plan around an obstacle longer than this many times the rest of the current path (plus
 /// [`DETOUR_SLACK`] m) is refused up to [`MAX_DETOUR_REFUSALS`] times in a row, one `wait_time`
 /// apart: a person standing in a cross corridor should not send the robot round the building.
@@ -154,22 +154,6 @@ fn remaining_length(path: &[[f64; 2]], seg: usize, from: &Pose2) -> f64 {
         .sum();
     (next[0] - from.x).hypot(next[1] - from.y) + rest
 }
-
-/// A stop the robot went on from: when it began, where, and when the robot went on.
-#[derive(Clone, Copy, Debug)]
-struct Resumed {
-    since: f64,
-    at: [f64; 2],
-    time: f64,
-}
-
-/// The way must look clear this long (s) before a stopped robot goes on: one clear reading of a
-/// noisy sensor is not enough.
-const CLEAR_TIME: f64 = 0.5;
-/// Stopping again within this time (s) and distance (m) of going on continues the same stop
-/// (same start of waiting, not counted again).
-const SAME_STOP_TIME: f64 = 3.0;
-const SAME_STOP_DIST: f64 = 0.5;
 
 impl Navigator {
     pub fn new(params: NavParams, tasks: Vec<Task>) -> Self {
@@ -575,284 +559,6 @@ impl Navigator {
                 self.brake(ctx.dt)
             }
         }
-    }
-
-    /// Driving and stopped by an obstacle: block (continuing the last stop if the robot went on
-    /// from it only just now and nearby).
-    fn stopped(&mut self, now: f64, pose: &Pose2, gap: f64) {
-        let same = self.resumed.take().filter(|r| {
-            now - r.time < SAME_STOP_TIME
-                && (pose.x - r.at[0]).hypot(pose.y - r.at[1]) < SAME_STOP_DIST
-        });
-        let since = match same {
-            Some(r) => r.since,
-            None => {
-                self.metrics.stops += 1;
-                self.log(
-                    now,
-                    format!(
-                        "stop at ({:.2}, {:.2}): obstacle {gap:.2} m ahead",
-                        pose.x, pose.y
-                    ),
-                );
-                now
-            }
-        };
-        self.phase = Phase::Blocked { since };
-        self.clear_since = None;
-    }
-
-    /// On the way to a spot to give way and stopped by an obstacle: one stop, and after
-    /// `wait_time` the robot waits where it is instead (the other robot plans around it).
-    fn held_on_the_way_aside(&mut self, now: f64, pose: &Pose2, gap: f64, for_robot: u32) {
-        match self.held_since {
-            None => {
-                self.held_since = Some(now);
-                self.metrics.stops += 1;
-                self.log(
-                    now,
-                    format!(
-                        "stop at ({:.2}, {:.2}) on the way aside: obstacle {gap:.2} m ahead",
-                        pose.x, pose.y
-                    ),
-                );
-            }
-            Some(since) if now - since >= self.params.wait_time => {
-                self.held_since = None;
-                self.phase = Phase::Yielding {
-                    for_robot,
-                    since: now,
-                    parked: true,
-                };
-                self.log(now, "cannot get aside: waiting here");
-            }
-            Some(_) => {}
-        }
-    }
-
-    fn replan_to_goal(&mut self, now: f64, why: &str) {
-        if let Some(g) = &self.goal {
-            self.request = Some(PlanRequest {
-                goal: [g.pose.x, g.pose.y],
-                around: Vec::new(),
-            });
-            self.metrics.replans += 1;
-            self.phase = Phase::Planning;
-            self.log(now, why);
-        } else {
-            self.phase = Phase::Idle;
-        }
-    }
-
-    /// A blocked robot decides: give way, wait, or plan around.
-    fn settle_block(
-        &mut self,
-        ctx: &ControlContext,
-        index: u32,
-        pose: &Pose2,
-        fleet: &Fleet,
-        since: f64,
-    ) {
-        let now = ctx.now;
-        let p = &self.params;
-        let me = self.fleet_entry(index, pose);
-        let reach = p.stop_distance + p.radius + 0.6;
-        if let Some(other) = fleet.robot_ahead(&me, p.radius + 0.05, reach) {
-            let clearance = me.radius + other.radius + 0.1;
-            let oncoming = comes_through(other, &me, clearance);
-            if matches!(other.activity, FleetActivity::Yielding { for_robot, parked: false } if for_robot == index)
-            {
-                return; // it is making room for us (once it is aside, plan around it if need be)
-            }
-            if oncoming {
-                if gives_way(&me, other) && now - since >= 0.5 {
-                    let keep_clear = other.path_ahead.clone();
-                    // a spot well out of the way if there is one (deeper into a bay), else
-                    // one just clear of the other robot's band
-                    let spot = |extra: f64| {
-                        yield_spot(
-                            ctx.costmap,
-                            [pose.x, pose.y],
-                            [other.pose.x, other.pose.y],
-                            me.radius + other.radius,
-                            &keep_clear,
-                            clearance + extra,
-                            15.0,
-                        )
-                    };
-                    match spot(0.35).or_else(|| spot(0.05)) {
-                        Some(path) => {
-                            let o = other.index;
-                            self.set_path(path);
-                            self.metrics.yields += 1;
-                            self.cannot_yield = false;
-                            self.held_since = None;
-                            self.phase = Phase::Yielding {
-                                for_robot: o,
-                                since: now,
-                                parked: false,
-                            };
-                            self.log(now, format!("giving way to robot #{o}"));
-                        }
-                        None => {
-                            if !self.cannot_yield {
-                                self.log(now, "nowhere to give way");
-                            }
-                            self.cannot_yield = true;
-                        }
-                    }
-                }
-                if !(self.cannot_yield && now - since >= self.params.wait_time) {
-                    return; // wait for the other robot to give way
-                }
-            } else if let Some(g) = &self.goal {
-                let at_goal = (other.pose.x - g.pose.x).hypot(other.pose.y - g.pose.y)
-                    < other.radius + me.radius + 0.3;
-                if at_goal && other.activity == FleetActivity::Parked {
-                    return; // it is using our goal: wait until it leaves
-                }
-            }
-        }
-        if now - since >= self.params.wait_time
-            && let Some(g) = &self.goal
-        {
-            let around = self.obstacles_world(pose);
-            let goal = [g.pose.x, g.pose.y];
-            self.request = Some(PlanRequest { goal, around });
-            self.metrics.replans += 1;
-            self.phase = Phase::Blocked { since: now };
-            self.log(now, "still blocked: planning around the obstacle");
-        }
-    }
-
-    /// Free distance (m) from the robot's outline to the nearest seen obstacle in the band it will
-    /// sweep: along the path ahead when there is one (so walls beside a doorway the path threads
-    /// do not count), straight ahead otherwise.
-    fn gap_ahead(&self, pose: &Pose2, map: &Costmap) -> f64 {
-        let r = self.params.radius;
-        let hw = r + 0.05;
-        let pts = self
-            .seen
-            .iter()
-            .flat_map(|s| s.points.iter())
-            .chain(self.extra.iter());
-        if self.path.len() < 2 {
-            let mut free = f64::INFINITY;
-            for &(x, y) in pts {
-                if x > 0.0 && (y as f64).abs() < hw {
-                    free = free.min(x as f64);
-                }
-            }
-            return free - r;
-        }
-        // the band: the robot's position, then the path from the segment it is on, for as far as
-        // stopping needs (plus a metre of look-ahead)
-        let v = self.follower.v.max(0.0);
-        let reach =
-            r + self.params.stop_distance + v * v / (2.0 * self.params.follower.max_accel) + 1.0;
-        let mut band = vec![[pose.x, pose.y]];
-        let mut len = 0.0;
-        for &q in &self.path[(self.follower.segment + 1).min(self.path.len() - 1)..] {
-            let last = band[band.len() - 1];
-            len += (q[0] - last[0]).hypot(q[1] - last[1]);
-            band.push(q);
-            if len > reach {
-                break;
-            }
-        }
-        // and the arc pure pursuit actually drives to its look-ahead point, which cuts inside
-        // the path's corners
-        let fp = &self.params.follower;
-        let arc = match self.params.steering {
-            Steering::DiffDrive => pursuit_arc(&self.path, self.follower.segment, pose, fp, v, 6),
-            Steering::Ackermann { .. } => Vec::new(),
-        };
-        let mut free = f64::INFINITY;
-        for &(x, y) in pts {
-            let w = pose.transform_point([x as f64, y as f64]);
-            // a point on a wall the map knows (within the inscribed radius of it) is not an
-            // obstacle to stop for: the plan already keeps clear of walls
-            let known_wall = map
-                .cell_of(w[0], w[1])
-                .is_none_or(|(c, r)| map.cost(c, r) >= INSCRIBED);
-            if known_wall {
-                continue;
-            }
-            if let Some(along) = along_band(&band, w, hw) {
-                free = free.min(along);
-            }
-            if let Some(along) = along_band(&arc, w, hw) {
-                free = free.min(along);
-            }
-        }
-        free - r
-    }
-
-    /// `fp` with the look-ahead shortened (halved down to [`MIN_LOOKAHEAD`]) until the arc pure
-    /// pursuit would drive to its look-ahead point keeps the robot's centre out of the inscribed
-    /// cells of the costmap: near walls (a doorway entered at an angle) the robot tracks the path
-    /// closely instead of cutting the corner into the frame. The collision check of the
-    /// look-ahead arc of Macenski et al., "Regulated Pure Pursuit for Robot Path Tracking",
-    /// Autonomous Robots 47 (2023), §3.3, reduced to choosing the look-ahead.
-    fn safe_lookahead(
-        &self,
-        pose: &Pose2,
-        map: &Costmap,
-        mut fp: FollowerParams,
-    ) -> FollowerParams {
-        if self.path.len() < 2 {
-            return fp;
-        }
-        let v = self.follower.v;
-        let mut lookahead = fp.lookahead + fp.lookahead_time * v.abs();
-        loop {
-            let mut trial = fp;
-            trial.lookahead = lookahead;
-            trial.lookahead_time = 0.0;
-            let n = ((lookahead * 1.6) / (0.5 * map.resolution)).ceil().max(2.0) as usize;
-            let arc = pursuit_arc(&self.path, self.follower.segment, pose, &trial, v, n);
-            // (the robot's own cell may already be inscribed when squeezed through a doorway)
-            let clear = arc.iter().skip(1).all(|q| {
-                map.cell_of(q[0], q[1])
-                    .is_some_and(|(c, r)| map.cost(c, r) < INSCRIBED)
-            });
-            if clear || lookahead <= MIN_LOOKAHEAD {
-                if lookahead < fp.lookahead + fp.lookahead_time * v.abs() {
-                    fp = trial;
-                }
-                return fp;
-            }
-            lookahead = (lookahead * 0.5).max(MIN_LOOKAHEAD);
-        }
-    }
-
-    /// True if the follower steers forward from here (its look-ahead point is within the
-    /// rotate threshold, so it is not turning on the spot).
-    fn wants_forward(&self, pose: &Pose2) -> bool {
-        if self.path.len() < 2 {
-            return false;
-        }
-        let fp = &self.params.follower;
-        let q = lookahead_point(&self.path, self.follower.segment, pose, fp, self.follower.v);
-        super::follower::bearing_to(pose, q).abs() < fp.rotate_threshold
-    }
-
-    /// Seen obstacle points within 4 m, in the world frame of the belief, to plan around: the
-    /// laser's when there is one (a sonar echo only says "somewhere in a 55° cone", and marking
-    /// the whole arc would close a corridor), else the sonars'.
-    fn obstacles_world(&self, pose: &Pose2) -> Vec<[f64; 2]> {
-        let mut out = Vec::new();
-        let pts: Box<dyn Iterator<Item = &(f32, f32)>> = match &self.seen {
-            Some(s) => Box::new(s.points.iter()),
-            None => Box::new(self.extra.iter()),
-        };
-        for &(x, y) in pts {
-            let (x, y) = (x as f64, y as f64);
-            if x * x + y * y <= 16.0 {
-                out.push(pose.transform_point([x, y]));
-            }
-        }
-        out
     }
 
     fn brake(&mut self, dt: f64) -> DriveCommand {

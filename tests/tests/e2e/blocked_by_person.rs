@@ -10,8 +10,9 @@ use systems::navigation::{Navigator, Phase};
 /// A corridor 2.4 m wide (y 0–2.4) and 14 m long, with a 2 × 2.6 m side room north of it at
 /// x 6–8 (doorway x 6.5–7.5). A person stands in the middle of the corridor at x 7 until
 /// `leaves_at` s, then walks into the room; robot `r` drives from x 1 to x 13 along the middle,
-/// waiting `wait` s at an obstacle before planning around it.
-fn corridor(leaves_at: f64, wait: f64) -> String {
+/// waiting `wait` s at an obstacle before planning around it. `sensors` are the robot's
+/// range-sensor tables.
+fn corridor(leaves_at: f64, wait: f64, sensors: &str) -> String {
     format!(
         r#"
 duration = 80.0
@@ -47,9 +48,7 @@ to = [8.05, 5.0]
 name = "r"
 start = [1.0, 1.2, 0.0]
 footprint = {{ circle = 0.3 }}
-[robots.sensors.laser]
-preset = "sick_lms100"
-mount = [0.15, 0.0, 0.0]
+{sensors}
 [robots.sensors.encoder]
 [robots.navigation]
 wait_time = {wait}
@@ -67,6 +66,10 @@ speed = 1.0
 "#
     )
 }
+
+const LASER: &str = "[robots.sensors.laser]\npreset = \"sick_lms100\"\nmount = [0.15, 0.0, 0.0]";
+/// The default SRF02-like ring (front, ±45°, rear) and no laser.
+const SONAR_ONLY: &str = "[robots.sensors.sonar]";
 
 /// What happened, tick by tick.
 struct Trace {
@@ -111,7 +114,7 @@ const TOUCH: f64 = 0.55;
 fn a_robot_stops_for_a_person_in_its_way_waits_and_goes_on_when_the_person_leaves() {
     // the robot reaches the person at about 10 s; the person stands until 25 s; the robot would
     // only plan around after 60 s
-    let (sim, trace) = run(&corridor(25.0, 60.0));
+    let (sim, trace) = run(&corridor(25.0, 60.0, LASER));
     let r = sim.robots[0];
     let nav = sim.world.get::<Navigator>(r).unwrap();
     let m = &nav.metrics;
@@ -143,7 +146,7 @@ fn a_robot_stops_for_a_person_in_its_way_waits_and_goes_on_when_the_person_leave
 #[test]
 fn a_robot_blocked_by_a_person_who_stays_plans_around_after_its_wait_time() {
     // the person never leaves; the robot waits 4 s, then passes beside them with room to spare
-    let (sim, trace) = run(&corridor(1000.0, 4.0));
+    let (sim, trace) = run(&corridor(1000.0, 4.0, LASER));
     let r = sim.robots[0];
     let nav = sim.world.get::<Navigator>(r).unwrap();
     let m = &nav.metrics;
@@ -170,4 +173,27 @@ fn a_robot_blocked_by_a_person_who_stays_plans_around_after_its_wait_time() {
     assert_eq!(nav.phase, Phase::Idle);
     let p = sim.world.get::<TruePose>(r).unwrap().pose;
     assert!((p.x - 13.0).hypot(p.y - 1.2) < 0.3, "at the goal: {p:?}");
+}
+
+#[test]
+fn a_robot_with_only_sonars_also_stops_for_the_person_and_goes_on_when_they_leave() {
+    // no laser: the stop check runs on the sonar ring alone (its echoes of the corridor walls
+    // are explained by the map, the person's are not)
+    let (sim, trace) = run(&corridor(25.0, 60.0, SONAR_ONLY));
+    let r = sim.robots[0];
+    let nav = sim.world.get::<Navigator>(r).unwrap();
+    let m = &nav.metrics;
+    assert!(nav.finished() && m.tasks_completed == 1, "{m:?}");
+    assert!(m.stops >= 1 && m.waiting_time_s > 10.0, "{m:?}");
+    assert!(
+        trace.closest > TOUCH + 0.05,
+        "never touched: {}",
+        trace.closest
+    );
+    let passed = trace.passed_at.expect("it passed the person's spot");
+    assert!(passed > 25.0 && passed < 35.0, "passed at {passed} s");
+    assert_eq!(
+        sim.world.get::<RobotMetrics>(r).unwrap().collisions.total(),
+        0
+    );
 }

@@ -1,6 +1,7 @@
 //! End-to-end tests: scenario in, metrics and files out. One test binary (every binary links
 //! rerun, so few binaries keep builds short).
 
+mod ackermann;
 mod blocked_by_person;
 mod common;
 mod determinism;
