@@ -15,11 +15,13 @@
 //! * [`euclidean`] — the thesis's Euclidean reference fitness (§7.1) and its distance-field form;
 //! * `normals`, `orientation`, `ref_grid`, `translation_search`, `refine`, `subsample`,
 //!   `improved` — the improved matcher's stages (private);
-//! * `matcher` — configuration and the entry point.
+//! * `matcher` — configuration and the entry point;
+//! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share.
 
 pub mod correlation;
 pub mod de;
 pub mod euclidean;
+pub mod prob_grid;
 pub mod scan_points;
 
 mod error;
@@ -46,4 +48,5 @@ pub use matcher::{
     MatchConfig, MatchResult, Method, SearchWindow, ThesisConfig, ThesisFitness, match_scans,
     match_scans_with_rng,
 };
+pub use prob_grid::ProbGrid;
 pub use scan_points::{laser_scan_points, scan_to_points, scan_to_points_into};
