@@ -147,7 +147,8 @@ pub fn filter_cloud(f: &Filter, cap: usize) -> Option<Cloud> {
             &d.tracker.population.costs,
             cap,
         )),
-        Filter::DeOdometry(_) => None,
+        // SLAM systems record their map and graph under robots/<name>/slam
+        Filter::DeOdometry(_) | Filter::Scan(_) => None,
     }
 }
 

@@ -10,6 +10,7 @@ use super::map::LocalizationMap;
 use super::markov_grid::MarkovGrid;
 use super::mcl::{BeamSubset, Mcl, PoseEstimate};
 use super::odometry::WheelOdometry;
+use super::scan_estimator::ScanEstimator;
 use crate::core::{KernelPool, Pose2};
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
@@ -22,6 +23,8 @@ pub enum Filter {
     DeFilter(Box<DeFilter>),
     DeMc(Box<DeMc>),
     DeOdometry(Box<DeOdometry>),
+    /// A SLAM system (or another estimator of a higher layer), fed in the Map set.
+    Scan(Box<dyn ScanEstimator>),
 }
 
 impl Filter {
@@ -33,6 +36,7 @@ impl Filter {
             Filter::DeFilter(_) => "de_filter",
             Filter::DeMc(_) => "de_mc",
             Filter::DeOdometry(_) => "de_odometry",
+            Filter::Scan(f) => f.kind(),
         }
     }
 
@@ -44,6 +48,7 @@ impl Filter {
             Filter::DeFilter(f) => f.config.max_beams,
             Filter::DeMc(f) => f.config.max_beams,
             Filter::DeOdometry(f) => f.config.max_beams,
+            Filter::Scan(f) => f.max_beams(),
         }
     }
 
@@ -55,7 +60,13 @@ impl Filter {
             Filter::DeFilter(f) => f.estimate(),
             Filter::DeMc(f) => f.estimate(),
             Filter::DeOdometry(f) => f.estimate,
+            Filter::Scan(f) => f.estimate(),
         }
+    }
+
+    /// True for estimators fed in the Map set (SLAM).
+    pub fn is_scan(&self) -> bool {
+        matches!(self, Filter::Scan(_))
     }
 }
 
@@ -88,14 +99,32 @@ impl Localizer {
     }
 
     /// Consumes one scan (beams already in the base frame) taken at odometry pose `odom`.
-    fn consume(&mut self, map: &LocalizationMap, scan_stamp: f64, scan: &ScanInput, odom: &Pose2) {
+    fn consume(
+        &mut self,
+        map: Option<&LocalizationMap>,
+        scan_stamp: f64,
+        scan: &ScanInput,
+        odom: &Pose2,
+    ) {
         let beams = scan.beams(self.filter.max_beams());
+        if let Filter::Scan(f) = &mut self.filter {
+            if f.update(scan_stamp, beams, odom)
+                && let Some(e) = f.estimate()
+            {
+                self.publish(scan_stamp, e);
+            }
+            return;
+        }
+        let Some(map) = map else {
+            return; // map-based filters only run where the map exists
+        };
         let updated = match &mut self.filter {
             Filter::Mcl(f) => f.update(map, beams, odom),
             Filter::MarkovGrid(f) => f.update(map, &beams.returns(), beams.range_max, odom),
             Filter::DeFilter(f) => f.update(map, beams, odom),
             Filter::DeMc(f) => f.update(map, beams, odom),
             Filter::DeOdometry(f) => f.update(&beams.returns(), odom),
+            Filter::Scan(_) => false,
         };
         if updated && let Some(e) = self.filter.estimate() {
             self.publish(scan_stamp, e);
@@ -140,13 +169,48 @@ pub struct Localizers {
 }
 
 impl Localizers {
-    fn beam_counts(&self) -> Vec<usize> {
-        self.items.iter().map(|l| l.filter.max_beams()).collect()
+    /// Feeds this tick's scans, in time order with the odometry pose at each scan's time, to the
+    /// localizers `select` picks (their fresh estimates cleared first). Kernels inside the
+    /// filters run on the run's rayon pool.
+    pub fn feed(
+        &mut self,
+        map: Option<&LocalizationMap>,
+        pool: &KernelPool,
+        scans: &LaserScans,
+        mount: Pose2,
+        odom: &WheelOdometry,
+        select: impl Fn(&Filter) -> bool,
+    ) {
+        let chosen: Vec<usize> = (0..self.items.len())
+            .filter(|&i| select(&self.items[i].filter))
+            .collect();
+        if chosen.is_empty() {
+            return;
+        }
+        for &i in &chosen {
+            self.items[i].fresh.clear();
+        }
+        for scan in &scans.scans {
+            let mut input = ScanInput {
+                scan,
+                mount,
+                subsets: Vec::new(),
+            };
+            for &i in &chosen {
+                input.prepare(self.items[i].filter.max_beams());
+            }
+            let at = odom.pose_at(scan.stamp);
+            pool.install(|| {
+                for &i in &chosen {
+                    self.items[i].consume(map, scan.stamp, &input, &at);
+                }
+            });
+        }
     }
 }
 
-/// Estimate: every localizer consumes this tick's scans, in time order, with the odometry pose at
-/// each scan's time. Kernels inside the filters run on the run's rayon pool.
+/// Estimate: every localizer (not the SLAM systems, fed in the Map set) consumes this tick's
+/// scans.
 pub fn run_localizers(
     map: Option<Res<LocalizationMap>>,
     pool: Res<KernelPool>,
@@ -155,27 +219,9 @@ pub fn run_localizers(
     let Some(map) = map else {
         return; // no robot carries a localizer
     };
-    let map: &LocalizationMap = &map;
     for (mut locs, scans, laser, odom) in robots.iter_mut() {
-        for l in locs.items.iter_mut() {
-            l.fresh.clear();
-        }
-        let counts = locs.beam_counts();
-        for scan in &scans.scans {
-            let mut input = ScanInput {
-                scan,
-                mount: laser.spec.mount,
-                subsets: Vec::new(),
-            };
-            for &m in &counts {
-                input.prepare(m);
-            }
-            let at = odom.pose_at(scan.stamp);
-            pool.install(|| {
-                for l in locs.items.iter_mut() {
-                    l.consume(map, scan.stamp, &input, &at);
-                }
-            });
-        }
+        locs.feed(Some(&map), &pool, scans, laser.spec.mount, odom, |f| {
+            !f.is_scan()
+        });
     }
 }

@@ -15,6 +15,7 @@ pub mod mcl;
 pub mod motion_model;
 pub mod nav_source;
 pub mod odometry;
+pub mod scan_estimator;
 
 #[cfg(test)]
 mod de_tests;
@@ -28,6 +29,7 @@ pub use mcl::{Mcl, MclConfig, PoseEstimate};
 pub use motion_model::OdometryMotionModel;
 pub use nav_source::NavSource;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};
+pub use scan_estimator::ScanEstimator;
 
 use crate::core::{SimPlugin, SimSet};
 use bevy_ecs::prelude::*;
