@@ -1,5 +1,6 @@
 //! The simulator's ECS vocabulary and every system, layered bottom-up:
-//! `core` ← `world` ← `raycast`/`body` ← `sensors` ← `matching` ← `localization` ← `navigation`/`eval`.
+//! `core` ← `world` ← `raycast`/`body` ← `sensors` ← `matching` ← `localization` ←
+//! `mapping`/`navigation`/`eval`.
 //! Nothing lower imports anything higher (see ../shared/DESIGN.md).
 //!
 //! Each feature folder exposes one [`core::schedule::SimPlugin`] that adds its systems to the
@@ -9,6 +10,7 @@ pub mod body;
 pub mod core;
 pub mod eval;
 pub mod localization;
+pub mod mapping;
 pub mod matching;
 pub mod navigation;
 pub mod raycast;

@@ -182,3 +182,51 @@ pub fn cast_dda(
         }
     }
 }
+
+/// The cells a segment crosses, in order from its start (Amanatides & Woo 1987): the segment
+/// from `p` along the unit direction `dir` for `len` metres, clipped to the `width` × `height`
+/// grid of `resolution` whose cell (0, 0) has its lower-left corner at `origin`. Calls
+/// `visit(row * width + col)` for every crossed cell inside the grid BEFORE the one holding the
+/// end point, and returns that end cell's index, or None when the end point is outside the grid
+/// (the segment's cells inside the grid have then all been visited). The occupancy mapper walks
+/// its beams with it: the visited cells are the free space a beam has passed, the end cell is
+/// where it ended.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn traverse_segment(
+    width: usize,
+    height: usize,
+    resolution: f32,
+    origin: [f32; 2],
+    p: [f32; 2],
+    dir: [f32; 2],
+    len: f32,
+    mut visit: impl FnMut(usize),
+) -> Option<usize> {
+    if width == 0 || height == 0 {
+        return None;
+    }
+    let gx = p[0] - origin[0];
+    let gy = p[1] - origin[1];
+    let [dx, dy] = dir;
+    let (wf, hf) = (width as f32 * resolution, height as f32 * resolution);
+    let t0 = if gx >= 0.0 && gy >= 0.0 && gx < wf && gy < hf {
+        0.0
+    } else {
+        enter_grid(gx, gy, dx, dy, wf, hf, len)?
+    };
+    let (w, h) = (width as i32, height as i32);
+    let mut walk = Ray::new(gx, gy, dx, dy, resolution).walk_at(t0, w, h);
+    loop {
+        let i = walk.cy as usize * width + walk.cx as usize;
+        // the next boundary lies beyond the end point: this cell holds it
+        if walk.t_max_x.min(walk.t_max_y) >= len {
+            return Some(i);
+        }
+        visit(i);
+        walk.step();
+        if walk.cx < 0 || walk.cy < 0 || walk.cx >= w || walk.cy >= h {
+            return None;
+        }
+    }
+}

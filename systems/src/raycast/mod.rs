@@ -2,6 +2,8 @@
 //! slices.
 //!
 //! - [`cast_dda`]: the reference, a plain Amanatides & Woo (1987) cell walk.
+//! - [`traverse_segment`]: the same walk visiting every cell a segment crosses (the occupancy
+//!   mapper's beam traversal).
 //! - [`RayMap`]: the static map as a one-byte Chebyshev distance field (rays leap across open
 //!   space and walk cell by cell only next to obstacles) plus the boundary faces of occupied
 //!   cells per tile. `cast` is one ray, `cast_many` many independent rays advanced in turn so
@@ -21,7 +23,7 @@ mod overlay;
 mod raymap;
 pub mod sweep;
 
-pub use dda::cast_dda;
+pub use dda::{cast_dda, traverse_segment};
 pub use overlay::{overlay_circles, overlay_segments};
 pub use raymap::RayMap;
 

@@ -402,3 +402,61 @@ fn scans_beyond_the_sweep_reach_or_from_outside_fall_back_to_rays() {
     }
     assert!(corners <= 30, "{corners} corner cases");
 }
+
+#[test]
+fn segment_traversal_visits_exactly_the_crossed_cells() {
+    let (w, h, res, origin) = (13usize, 9usize, 0.3f32, [-1.0f32, 0.5f32]);
+    let cell = |x: f32, y: f32| {
+        (
+            ((x - origin[0]) / res).floor() as i32,
+            ((y - origin[1]) / res).floor() as i32,
+        )
+    };
+    let inside = |c: (i32, i32)| c.0 >= 0 && c.1 >= 0 && c.0 < w as i32 && c.1 < h as i32;
+    let mut rng = XorShift(23);
+    let (mut full, mut clipped) = (0, 0);
+    for _ in 0..4000 {
+        // start and end anywhere in a margin around the grid
+        let p = [
+            origin[0] - 1.0 + rng.f() * (w as f32 * res + 2.0),
+            origin[1] - 1.0 + rng.f() * (h as f32 * res + 2.0),
+        ];
+        let a = rng.f() * 2.0 * PI - PI;
+        let len = rng.f() * 5.0;
+        let dir = [a.cos(), a.sin()];
+        let e = [p[0] + dir[0] * len, p[1] + dir[1] * len];
+        let mut seen = Vec::new();
+        let end = traverse_segment(w, h, res, origin, p, dir, len, |i| seen.push(i));
+        let to_cell = |i: usize| ((i % w) as i32, (i / w) as i32);
+        let mut chain: Vec<(i32, i32)> = seen.iter().map(|&i| to_cell(i)).collect();
+        // the end cell is returned exactly when the end point is inside the grid
+        assert_eq!(end.is_some(), inside(cell(e[0], e[1])), "{p:?} {a} {len}");
+        if let Some(i) = end {
+            assert_eq!(to_cell(i), cell(e[0], e[1]));
+            chain.push(to_cell(i));
+        }
+        // consecutive cells are 4-neighbours (each boundary crossed once, no cell skipped)
+        for pair in chain.windows(2) {
+            let d = (pair[1].0 - pair[0].0).abs() + (pair[1].1 - pair[0].1).abs();
+            assert_eq!(d, 1, "{p:?} {a} {len}: {chain:?}");
+        }
+        // a start inside the grid: the chain runs from the start cell to the end cell
+        if inside(cell(p[0], p[1])) && end.is_some() {
+            full += 1;
+            let (s, t) = (cell(p[0], p[1]), cell(e[0], e[1]));
+            assert_eq!(chain[0], s);
+            assert_eq!(seen.len() as i32, (t.0 - s.0).abs() + (t.1 - s.1).abs());
+        } else if !chain.is_empty() {
+            clipped += 1;
+        }
+        // every point of the segment inside the grid lies in a listed cell
+        for k in 0..=200 {
+            let t = len * k as f32 / 200.0;
+            let c = cell(p[0] + dir[0] * t, p[1] + dir[1] * t);
+            if inside(c) {
+                assert!(chain.contains(&c), "{p:?} {a} {len}: {c:?} missing");
+            }
+        }
+    }
+    assert!(full > 300 && clipped > 300, "{full} {clipped}");
+}
