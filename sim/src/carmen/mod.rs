@@ -5,7 +5,7 @@
 //! # Format read
 //!
 //! One message per line, fields separated by whitespace; a line whose first non-blank character
-//! is `#` is a comment; blank lines are ignored. Every message ends with the trailer
+//! is `#` is a comment; blank lines are ignored. Every message but PARAM ends with the trailer
 //! `timestamp hostname logger_timestamp` (all three required); records keep `timestamp` (the
 //! IPC time, seconds), the hostname and logger time are checked and dropped. Numbers may use any
 //! float notation Rust's parser accepts (`1`, `-0.5`, `.5`, `1e-3`, `1.5E+2`, `inf`); integers
@@ -73,6 +73,15 @@
 //! those (these carry no geometry: readers rebuild it from the PARAMs, symmetric about 0).
 //! Hostname is `sim`, logger_timestamp = timestamp. Numbers are written in Rust's shortest
 //! round-trip form, so write → read gives identical records.
+//!
+//! # Errors
+//!
+//! Reading never panics. A malformed line of a known type is a [`CarmenError::Line`] naming
+//! the file, the 1-based line, the message type and a [`LineError`]: a missing field, a field
+//! that is not what the format needs (non-numeric, NaN/inf outside ranges, negative range,
+//! non-integer count, non-positive maximum range or honoured PARAM), a `num_readings` /
+//! `num_remissions` that does not match the fields present, or fields left over, e.g.
+//! `intel.log:12: FLASER: expected 180 range readings, found 179 (…)`.
 //!
 //! # Use from the CLI (wired elsewhere)
 //!
