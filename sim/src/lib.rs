@@ -5,6 +5,7 @@ pub mod bench;
 pub mod bench_loc;
 pub mod bench_match;
 pub mod build;
+pub mod carmen;
 pub mod experiment;
 pub mod match_cmd;
 pub mod record;
