@@ -48,7 +48,7 @@ impl Filter {
             Filter::DeFilter(f) => f.config.max_beams,
             Filter::DeMc(f) => f.config.max_beams,
             Filter::DeOdometry(f) => f.config.max_beams,
-            Filter::Scan(f) => f.max_beams(),
+            Filter::Scan(_) => 0, // reads the whole scan
         }
     }
 
@@ -106,9 +106,8 @@ impl Localizer {
         scan: &ScanInput,
         odom: &Pose2,
     ) {
-        let beams = scan.beams(self.filter.max_beams());
         if let Filter::Scan(f) = &mut self.filter {
-            if f.update(scan_stamp, beams, odom)
+            if f.update(scan.scan, &scan.mount, odom)
                 && let Some(e) = f.estimate()
             {
                 self.publish(scan_stamp, e);
@@ -118,6 +117,7 @@ impl Localizer {
         let Some(map) = map else {
             return; // map-based filters only run where the map exists
         };
+        let beams = scan.beams(self.filter.max_beams());
         let updated = match &mut self.filter {
             Filter::Mcl(f) => f.update(map, beams, odom),
             Filter::MarkovGrid(f) => f.update(map, &beams.returns(), beams.range_max, odom),
@@ -197,7 +197,9 @@ impl Localizers {
                 subsets: Vec::new(),
             };
             for &i in &chosen {
-                input.prepare(self.items[i].filter.max_beams());
+                if !self.items[i].filter.is_scan() {
+                    input.prepare(self.items[i].filter.max_beams());
+                }
             }
             let at = odom.pose_at(scan.stamp);
             pool.install(|| {

@@ -4,19 +4,18 @@
 //! evaluated (ATE/RPE), summarised and recorded exactly like a localizer's; their scans are fed
 //! in the Map set of the tick, after the localizers (DESIGN.md, tick order).
 
-use super::mcl::{BeamSubset, PoseEstimate};
+use super::mcl::PoseEstimate;
 use crate::core::Pose2;
+use crate::sensors::LaserScan;
 use std::any::Any;
 use std::fmt::Debug;
 
 pub trait ScanEstimator: Send + Sync + Debug {
     /// The type name as written in scenario files (e.g. `scan_to_map`).
     fn kind(&self) -> &'static str;
-    /// Beams of a scan it reads.
-    fn max_beams(&self) -> usize;
-    /// Consumes one scan (beams in the base frame) stamped `stamp`, taken at odometry pose
-    /// `odom`; true if it published a new estimate.
-    fn update(&mut self, stamp: f64, beams: &BeamSubset, odom: &Pose2) -> bool;
+    /// Consumes one scan (as the laser published it, from `mount`, its pose in the base frame)
+    /// taken at odometry pose `odom`; true if it published a new estimate.
+    fn update(&mut self, scan: &LaserScan, mount: &Pose2, odom: &Pose2) -> bool;
     /// The latest estimate.
     fn estimate(&self) -> Option<PoseEstimate>;
     fn box_clone(&self) -> Box<dyn ScanEstimator>;
