@@ -16,11 +16,16 @@
 //! * `normals`, `orientation`, `ref_grid`, `translation_search`, `refine`, `subsample`,
 //!   `improved` — the improved matcher's stages (private);
 //! * `matcher` — configuration and the entry point;
-//! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share.
+//! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share;
+//! * [`map_pyramid`] — its multi-resolution form for Gauss-Newton matching (Hector SLAM, §IV.C);
+//! * [`gauss_newton`] — Hector-style scan-to-map matching, [`match_scan`]`(pyramid, points,
+//!   initial, prior, &params) -> GnResult` (Kohlbrecher et al., SSRR 2011, §IV).
 
 pub mod correlation;
 pub mod de;
 pub mod euclidean;
+pub mod gauss_newton;
+pub mod map_pyramid;
 pub mod prob_grid;
 pub mod scan_points;
 
@@ -43,7 +48,11 @@ pub use correlation::{CorrelationFitness, RasterSpec};
 pub use de::{Bounds, Crossover, DeOutcome, DeParams, StallStop, StopReason, Strategy, Vector};
 pub use error::MatchError;
 pub use euclidean::{EuclideanField, euclidean_brute};
+pub use gauss_newton::{GaussNewtonParams, GnResult, OdometryPrior, match_scan};
 pub use improved::ImprovedConfig;
+pub use map_pyramid::{
+    Combine, MapPyramid, MapSample, PyramidLevel, PyramidOptions, Surfaces, UPDATE_TILE,
+};
 pub use matcher::{
     MatchConfig, MatchResult, Method, SearchWindow, ThesisConfig, ThesisFitness, match_scans,
     match_scans_with_rng,
