@@ -19,6 +19,7 @@ use systems::localization::{
     Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
     NavSource, OdometryModel, WheelOdometry,
 };
+use systems::mapping::{MappingPlugin, ScanToMapSlam};
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
@@ -122,12 +123,13 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
 
     let mut schedule = new_schedule();
     schedule.add_systems(fire_events.in_set(SimSet::Script));
-    let plugins: [&dyn SimPlugin; 6] = [
+    let plugins: [&dyn SimPlugin; 7] = [
         &NavigationPlugin,
         &PeoplePlugin,
         &PhysicsPlugin,
         &SensorsPlugin,
         &LocalizationPlugin,
+        &MappingPlugin,
         &EvalPlugin,
     ];
     for p in plugins {
@@ -263,6 +265,9 @@ fn spawn_robot(
                         }
                         LocalizerKind::DeOdometry(c) => {
                             Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
+                        }
+                        LocalizerKind::ScanToMap(c) => {
+                            Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone())))
                         }
                     };
                     Localizer::new(l.name.clone(), filter)

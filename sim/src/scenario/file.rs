@@ -92,6 +92,8 @@ pub struct RobotFile {
     /// Localizers (`[[robots.localization]]` tables or an inline array).
     #[serde(default)]
     pub localization: Vec<super::localizers::LocalizerFile>,
+    /// SLAM systems: one `slam = { type = … }` table or `[[robots.slam]]` tables.
+    pub slam: Option<super::slam::SlamList>,
     /// Planner, follower and stop-and-wait settings of a robot with tasks.
     pub navigation: Option<NavigationFile>,
     /// The robot's task queue (`[[robots.tasks]]`).

@@ -12,6 +12,7 @@ pub mod people;
 pub mod places;
 pub mod resolve;
 pub mod sensors;
+pub mod slam;
 pub mod sonar;
 
 pub use error::ScenarioError;

@@ -346,6 +346,17 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
                 Ok(pose)
             },
         )?;
+        let mut localizers = localizers;
+        let slam =
+            super::slam::resolve_slam(&c, &p.key("slam"), r.slam.as_ref(), &start, &localizers)?;
+        if !slam.is_empty() && (laser.is_none() || encoder.is_none()) {
+            return c.err(
+                &p.key("slam"),
+                "SLAM reads the laser and the wheel odometry: give the robot \
+                 `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
+            );
+        }
+        localizers.extend(slam);
         if !localizers.is_empty() && (laser.is_none() || encoder.is_none()) {
             return c.err(
                 &lp,

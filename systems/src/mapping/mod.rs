@@ -7,12 +7,17 @@
 //!   and recall (observable true walls covered), after aligning the frames;
 //! * [`align`] — that alignment: from the robot's true start pose, optionally refined by chamfer
 //!   matching;
+//! * [`matched_map`] — a map matched against and inserted into scan after scan (map, mirror,
+//!   pyramid);
+//! * [`scan_to_map`] — scan-to-map SLAM (Hector-style Gauss-Newton with an odometry prior);
 //! * `grow` — a grid's extent on a fixed cell lattice and growth by whole blocks (private).
 
 pub mod align;
 mod grow;
+pub mod matched_map;
 pub mod occupancy;
 pub mod quality;
+pub mod scan_to_map;
 
 #[cfg(test)]
 mod tests;
@@ -20,3 +25,32 @@ mod tests;
 pub use align::{refine_alignment, start_pose_alignment};
 pub use occupancy::{InsertStats, LogOddsMap, OccupancyParams};
 pub use quality::{MapQuality, map_quality, quality_with_start_pose};
+
+pub use scan_to_map::{ScanToMapConfig, ScanToMapSlam};
+
+use crate::core::{KernelPool, SimPlugin, SimSet};
+use crate::localization::{LocalizationMap, Localizers, WheelOdometry};
+use crate::sensors::{Laser, LaserScans};
+use bevy_ecs::prelude::*;
+
+/// Adds the SLAM systems' feed to the Map set.
+pub struct MappingPlugin;
+
+impl SimPlugin for MappingPlugin {
+    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
+        schedule.add_systems(run_slam.in_set(SimSet::Map));
+    }
+}
+
+/// Map: every SLAM system (a [`crate::localization::Filter::Scan`] among a robot's localizers)
+/// consumes this tick's scans with the odometry pose at each scan's time.
+pub fn run_slam(
+    map: Option<Res<LocalizationMap>>,
+    pool: Res<KernelPool>,
+    mut robots: Query<(&mut Localizers, &LaserScans, &Laser, &WheelOdometry)>,
+) {
+    let map = map.as_deref();
+    for (mut locs, scans, laser, odom) in robots.iter_mut() {
+        locs.feed(map, &pool, scans, laser.spec.mount, odom, |f| f.is_scan());
+    }
+}

@@ -13,4 +13,5 @@ mod physics;
 mod recording;
 mod scenarios;
 mod sensors;
+mod slam;
 mod sonar;

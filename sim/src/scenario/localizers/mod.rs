@@ -351,6 +351,8 @@ pub enum LocalizerKind {
     DeFilter(DeFilterConfig),
     DeMc(DeMcConfig),
     DeOdometry(DeOdometryConfig),
+    /// Scan-to-map SLAM (from the robot's `slam` key).
+    ScanToMap(Box<systems::mapping::ScanToMapConfig>),
 }
 
 impl LocalizerConfig {
@@ -359,9 +361,10 @@ impl LocalizerConfig {
         match &self.kind {
             LocalizerKind::Mcl(m) => Some(m.laser.max_dist),
             LocalizerKind::MarkovGrid(m) => Some(m.laser.max_dist),
-            LocalizerKind::DeFilter(_) | LocalizerKind::DeMc(_) | LocalizerKind::DeOdometry(_) => {
-                None
-            }
+            LocalizerKind::DeFilter(_)
+            | LocalizerKind::DeMc(_)
+            | LocalizerKind::DeOdometry(_)
+            | LocalizerKind::ScanToMap(_) => None,
         }
     }
 }

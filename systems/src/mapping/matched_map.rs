@@ -1,0 +1,143 @@
+//! A map that is matched against and inserted into, scan after scan: the log-odds occupancy map
+//! ([`super::occupancy`]), its probability mirror and the multi-resolution pyramid the
+//! Gauss-Newton matcher ([`crate::matching::gauss_newton`]) reads, kept in step by updating only
+//! the window a scan touched (Kohlbrecher et al., SSRR 2011, §IV: Hector's map update and match
+//! loop). The scan-to-map SLAM owns one; the graph SLAM one per submap.
+
+use super::occupancy::{LogOddsMap, OccupancyParams, probability};
+use crate::core::Pose2;
+use crate::matching::ProbGrid;
+use crate::matching::gauss_newton::{GaussNewtonParams, GnResult, OdometryPrior, match_scan};
+use crate::matching::map_pyramid::{MapPyramid, PyramidOptions};
+use crate::sensors::LaserScan;
+
+#[derive(Clone, Debug)]
+pub struct MatchedMap {
+    map: LogOddsMap,
+    prob: ProbGrid,
+    pyramid: Option<MapPyramid>,
+    levels: usize,
+    /// Scans inserted so far.
+    pub scans: usize,
+}
+
+impl MatchedMap {
+    /// An empty, growing map of `resolution` with a pyramid of `levels`.
+    pub fn new(resolution: f64, params: OccupancyParams, levels: usize) -> Self {
+        MatchedMap {
+            map: LogOddsMap::new(resolution, params),
+            prob: ProbGrid::new(0, 0, resolution, [0.0, 0.0], 0.5),
+            pyramid: None,
+            levels: levels.max(1),
+            scans: 0,
+        }
+    }
+
+    pub fn log_odds(&self) -> &LogOddsMap {
+        &self.map
+    }
+
+    /// P(occupied) per cell (0.5 unknown).
+    pub fn prob(&self) -> &ProbGrid {
+        &self.prob
+    }
+
+    /// Inserts `scan` taken from `sensor` (the laser's pose in the map frame) and brings the
+    /// mirror and the pyramid up to date.
+    pub fn insert(&mut self, sensor: &Pose2, scan: &LaserScan) {
+        let before = (self.map.width(), self.map.height(), self.map.origin());
+        self.map.insert_scan(sensor, scan);
+        self.scans += 1;
+        let after = (self.map.width(), self.map.height(), self.map.origin());
+        if before != after || self.pyramid.is_none() {
+            self.prob = self.map.to_prob_grid();
+            self.pyramid = Some(MapPyramid::with_options(
+                &self.prob,
+                self.levels,
+                PyramidOptions::slam_map(),
+            ));
+            return;
+        }
+        let Some([c0, r0, c1, r1]) = self.touched(sensor, scan) else {
+            return;
+        };
+        let w = self.prob.width;
+        let lo = self.map.log_odds();
+        for r in r0..r1 {
+            for c in c0..c1 {
+                let i = r * w + c;
+                self.prob.p[i] = probability(lo[i]);
+            }
+        }
+        if let Some(p) = &mut self.pyramid {
+            p.update_region(&self.prob, c0, r0, c1, r1);
+        }
+    }
+
+    /// The cell window [c0, c1) × [r0, r1) a scan from `sensor` can have changed: the box of
+    /// the sensor and every beam's end (returns at their range, others at the clearing range),
+    /// one cell of margin, clipped to the map.
+    fn touched(&self, sensor: &Pose2, scan: &LaserScan) -> Option<[usize; 4]> {
+        let p = self.map.params();
+        let max_range = scan.range_max.min(p.max_range);
+        let clear = p.clear_range.min(max_range).max(0.0);
+        let (mut x0, mut y0, mut x1, mut y1) = (sensor.x, sensor.y, sensor.x, sensor.y);
+        for (k, &r) in scan.ranges.iter().enumerate() {
+            let len = if r.is_nan() || r < scan.range_min {
+                continue;
+            } else if r <= max_range {
+                r
+            } else {
+                clear
+            };
+            let a = sensor.theta + scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
+            let (x, y) = (
+                sensor.x + len as f64 * a.cos(),
+                sensor.y + len as f64 * a.sin(),
+            );
+            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+        }
+        let res = self.prob.resolution;
+        let [ox, oy] = self.prob.origin;
+        let cell = |v: f64, o: f64, n: usize, pad: f64| -> usize {
+            (((v - o) / res).floor() + pad).clamp(0.0, n as f64) as usize
+        };
+        let (w, h) = (self.prob.width, self.prob.height);
+        let c0 = cell(x0, ox, w, -1.0);
+        let r0 = cell(y0, oy, h, -1.0);
+        let c1 = cell(x1, ox, w, 2.0);
+        let r1 = cell(y1, oy, h, 2.0);
+        (c0 < c1 && r0 < r1).then_some([c0, r0, c1, r1])
+    }
+
+    /// Matches `points` (end points in the robot's base frame) from `guess` (the base pose in the
+    /// map frame); None before the first scan is inserted.
+    pub fn match_points(
+        &self,
+        points: &[[f32; 2]],
+        guess: Pose2,
+        prior: Option<OdometryPrior>,
+        params: &GaussNewtonParams,
+    ) -> Option<GnResult> {
+        let pyramid = self.pyramid.as_ref()?;
+        Some(match_scan(pyramid, points, guess, prior, params))
+    }
+}
+
+/// The end points of a scan's returns in the robot's base frame (the laser at `mount`), every
+/// `stride`-th beam.
+pub fn base_points(scan: &LaserScan, mount: &Pose2, stride: usize) -> Vec<[f32; 2]> {
+    let stride = stride.max(1);
+    let max = scan.range_max;
+    scan.ranges
+        .iter()
+        .enumerate()
+        .step_by(stride)
+        .filter(|&(_, &r)| r.is_finite() && r >= scan.range_min && r < max)
+        .map(|(k, &r)| {
+            let a = scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
+            let p = mount.transform_point([r as f64 * a.cos(), r as f64 * a.sin()]);
+            [p[0] as f32, p[1] as f32]
+        })
+        .collect()
+}

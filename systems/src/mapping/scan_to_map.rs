@@ -1,0 +1,198 @@
+//! Scan-to-map SLAM in the spirit of Hector SLAM (Kohlbrecher et al., SSRR 2011, §IV): every
+//! scan is matched by Gauss-Newton against the map built so far (a multi-resolution pyramid),
+//! and inserted into it once the robot has moved far enough. This is the fix 000_9f0113837c153763
+//! proposes for its scan-to-scan drift (SEEDS.md, maze experiment: "match each scan against the
+//! map built so far").
+//!
+//! Unlike Hector, which has no odometry, the wheel odometry predicts each match's starting guess
+//! and (optionally) pulls the result towards it with a prior whose spread grows with the motion
+//! since the last scan, so a featureless corridor — where Hector gets lost (001_6ab7973871dfdca6,
+//! MIT corridor) — leaves the estimate on the odometry along the corridor axis instead of
+//! sliding. The map frame is the world frame: the SLAM starts at the robot's known start pose.
+
+use super::matched_map::{MatchedMap, base_points};
+use super::occupancy::OccupancyParams;
+use crate::core::{Pose2, wrap_angle};
+use crate::localization::{PoseEstimate, ScanEstimator};
+use crate::matching::ProbGrid;
+use crate::matching::gauss_newton::{GaussNewtonParams, OdometryPrior};
+use crate::sensors::LaserScan;
+use std::any::Any;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScanToMapConfig {
+    /// Map cell size (m).
+    pub resolution: f64,
+    /// Pyramid levels (each half the resolution of the one below).
+    pub levels: usize,
+    pub occupancy: OccupancyParams,
+    pub matcher: GaussNewtonParams,
+    /// Insert a scan into the map once the robot moved this far (m) or turned this much (rad)
+    /// since the last insertion (Hector's map_update_distance_thresh / angle_thresh).
+    pub map_update_min_d: f64,
+    pub map_update_min_a: f64,
+    /// Use every n-th beam for matching.
+    pub beam_stride: usize,
+    /// Odometry prior: standard deviations [x, y (m), θ (rad)] at zero motion and their growth
+    /// per metre and per radian of motion; None matches without a prior (Hector proper).
+    pub prior: Option<OdometryPriorModel>,
+    /// The map frame's pose of the robot at its first scan.
+    pub init_pose: Pose2,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OdometryPriorModel {
+    pub base_std: [f64; 3],
+    /// Extra σ per metre travelled (position and heading) and per radian turned (heading).
+    pub per_metre: f64,
+    pub per_radian: f64,
+}
+
+impl Default for OdometryPriorModel {
+    fn default() -> Self {
+        OdometryPriorModel {
+            base_std: [0.05, 0.05, 0.02],
+            per_metre: 0.2,
+            per_radian: 0.2,
+        }
+    }
+}
+
+impl Default for ScanToMapConfig {
+    fn default() -> Self {
+        ScanToMapConfig {
+            resolution: 0.05,
+            levels: 3,
+            occupancy: OccupancyParams::default(),
+            matcher: GaussNewtonParams::default(),
+            map_update_min_d: 0.2,
+            map_update_min_a: 0.15,
+            beam_stride: 2,
+            prior: Some(OdometryPriorModel::default()),
+            init_pose: Pose2::default(),
+        }
+    }
+}
+
+impl OdometryPriorModel {
+    /// The prior on `predicted` after odometry moved by `delta`.
+    pub fn prior(&self, predicted: Pose2, delta: &Pose2) -> OdometryPrior {
+        let d = delta.x.hypot(delta.y);
+        let a = delta.theta.abs();
+        let s = self.base_std;
+        OdometryPrior::from_std(
+            predicted,
+            [
+                s[0] + self.per_metre * d,
+                s[1] + self.per_metre * d,
+                s[2] + self.per_metre * d + self.per_radian * a,
+            ],
+        )
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct ScanToMapSlam {
+    pub config: ScanToMapConfig,
+    pub map: MatchedMap,
+    pose: Pose2,
+    last_odom: Option<Pose2>,
+    last_insert: Option<Pose2>,
+    pub estimate: Option<PoseEstimate>,
+    /// Matches run, and those that did not converge.
+    pub matches: usize,
+    pub unconverged: usize,
+}
+
+impl ScanToMapSlam {
+    pub fn new(config: ScanToMapConfig) -> Self {
+        let map = MatchedMap::new(config.resolution, config.occupancy.clone(), config.levels);
+        ScanToMapSlam {
+            pose: config.init_pose,
+            config,
+            map,
+            last_odom: None,
+            last_insert: None,
+            estimate: None,
+            matches: 0,
+            unconverged: 0,
+        }
+    }
+
+    /// The robot's pose in the map frame.
+    pub fn pose(&self) -> Pose2 {
+        self.pose
+    }
+
+    /// The map as P(occupied) per cell.
+    pub fn prob_map(&self) -> &ProbGrid {
+        self.map.prob()
+    }
+
+    /// One scan: predict by odometry, match against the map, insert if the robot moved enough.
+    pub fn step(&mut self, scan: &LaserScan, mount: &Pose2, odom: &Pose2) {
+        let delta = match self.last_odom {
+            Some(prev) => prev.between(odom),
+            None => Pose2::default(),
+        };
+        self.last_odom = Some(*odom);
+        let predicted = self.pose.compose(&delta);
+        let mut covariance = [[0.0; 3]; 3];
+        self.pose = predicted;
+        let points = base_points(scan, mount, self.config.beam_stride);
+        let prior = self.config.prior.map(|m| m.prior(predicted, &delta));
+        if points.len() >= 3
+            && let Some(r) = self
+                .map
+                .match_points(&points, predicted, prior, &self.config.matcher)
+        {
+            self.matches += 1;
+            if !r.converged {
+                self.unconverged += 1;
+            }
+            if r.pose.x.is_finite() && r.pose.y.is_finite() && r.pose.theta.is_finite() {
+                self.pose = r.pose;
+                covariance = r.covariance;
+            }
+        }
+        let due = match self.last_insert {
+            None => true,
+            Some(p) => {
+                p.distance(&self.pose) >= self.config.map_update_min_d
+                    || wrap_angle(p.theta - self.pose.theta).abs() >= self.config.map_update_min_a
+            }
+        };
+        if due {
+            self.map.insert(&self.pose.compose(mount), scan);
+            self.last_insert = Some(self.pose);
+        }
+        self.estimate = Some(PoseEstimate {
+            pose: self.pose,
+            covariance,
+            weight: 1.0,
+        });
+    }
+}
+
+impl ScanEstimator for ScanToMapSlam {
+    fn kind(&self) -> &'static str {
+        "scan_to_map"
+    }
+
+    fn update(&mut self, scan: &LaserScan, mount: &Pose2, odom: &Pose2) -> bool {
+        self.step(scan, mount, odom);
+        true
+    }
+
+    fn estimate(&self) -> Option<PoseEstimate> {
+        self.estimate
+    }
+
+    fn box_clone(&self) -> Box<dyn ScanEstimator> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+}
