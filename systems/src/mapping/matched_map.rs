@@ -46,7 +46,7 @@ impl MatchedMap {
     /// mirror and the pyramid up to date.
     pub fn insert(&mut self, sensor: &Pose2, scan: &LaserScan) {
         let before = (self.map.width(), self.map.height(), self.map.origin());
-        self.map.insert_scan(sensor, scan);
+        let stats = self.map.insert_scan(sensor, scan);
         self.scans += 1;
         let after = (self.map.width(), self.map.height(), self.map.origin());
         if before != after || self.pyramid.is_none() {
@@ -58,7 +58,7 @@ impl MatchedMap {
             ));
             return;
         }
-        let Some([c0, r0, c1, r1]) = self.touched(sensor, scan) else {
+        let Some([c0, r0, c1, r1]) = stats.window else {
             return;
         };
         let w = self.prob.width;
@@ -72,42 +72,6 @@ impl MatchedMap {
         if let Some(p) = &mut self.pyramid {
             p.update_region(&self.prob, c0, r0, c1, r1);
         }
-    }
-
-    /// The cell window [c0, c1) × [r0, r1) a scan from `sensor` can have changed: the box of
-    /// the sensor and every beam's end (returns at their range, others at the clearing range),
-    /// one cell of margin, clipped to the map.
-    fn touched(&self, sensor: &Pose2, scan: &LaserScan) -> Option<[usize; 4]> {
-        let p = self.map.params();
-        let max_range = scan.range_max.min(p.max_range);
-        let clear = p.clear_range.min(max_range).max(0.0);
-        let (mut x0, mut y0, mut x1, mut y1) = (sensor.x, sensor.y, sensor.x, sensor.y);
-        for (k, &r) in scan.ranges.iter().enumerate() {
-            let len = if r.is_nan() || r < scan.range_min {
-                continue;
-            } else if r <= max_range {
-                r
-            } else {
-                clear
-            };
-            let a = sensor.theta + scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
-            let (x, y) = (
-                sensor.x + len as f64 * a.cos(),
-                sensor.y + len as f64 * a.sin(),
-            );
-            (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
-        }
-        let res = self.prob.resolution;
-        let [ox, oy] = self.prob.origin;
-        let cell = |v: f64, o: f64, n: usize, pad: f64| -> usize {
-            (((v - o) / res).floor() + pad).clamp(0.0, n as f64) as usize
-        };
-        let (w, h) = (self.prob.width, self.prob.height);
-        let c0 = cell(x0, ox, w, -1.0);
-        let r0 = cell(y0, oy, h, -1.0);
-        let c1 = cell(x1, ox, w, 2.0);
-        let r1 = cell(y1, oy, h, 2.0);
-        (c0 < c1 && r0 < r1).then_some([c0, r0, c1, r1])
     }
 
     /// Matches `points` (end points in the robot's base frame) from `guess` (the base pose in the

@@ -87,6 +87,9 @@ pub struct InsertStats {
     pub clears: usize,
     /// Readings not used: NaN, −Inf, below `range_min`.
     pub ignored: usize,
+    /// The cells [c0, c1) × [r0, r1) the scan may have changed (the box of the sensor and the
+    /// beams' ends with a cell of margin, clipped to the grid), for callers that mirror the map.
+    pub window: Option<[usize; 4]>,
 }
 
 /// An occupancy grid of log-odds, filled by [`LogOddsMap::insert_scan`].
@@ -230,9 +233,11 @@ impl LogOddsMap {
             let (s, c) = a.sin_cos();
             beams.push(([c as f32, s as f32], len, hit));
         }
+        let (lo, hi) = beam_box([sensor.x, sensor.y], &beams);
         if self.grows {
-            self.grow_around([sensor.x, sensor.y], &beams);
+            self.grow_to_hold(lo, hi);
         }
+        stats.window = self.window(lo, hi);
         self.next_scan();
         let (w, h) = (self.width(), self.height());
         let res = self.extent.resolution;
@@ -282,16 +287,22 @@ impl LogOddsMap {
         }
     }
 
-    /// Grows the grid (whole blocks, a cell of margin) to hold the sensor and every beam's end
-    /// point: their bounding box, not the full range circle, so a scan in a corridor does not
+    /// The box [lo, hi] (world) with a cell of margin, clipped to the grid, as cells.
+    fn window(&self, lo: [f64; 2], hi: [f64; 2]) -> Option<[usize; 4]> {
+        let [c0, r0] = self.extent.cell_coords(lo[0], lo[1]);
+        let [c1, r1] = self.extent.cell_coords(hi[0], hi[1]);
+        let (w, h) = (self.width() as i64, self.height() as i64);
+        let c0 = (c0 - 1).clamp(0, w) as usize;
+        let r0 = (r0 - 1).clamp(0, h) as usize;
+        let c1 = (c1 + 2).clamp(0, w) as usize;
+        let r1 = (r1 + 2).clamp(0, h) as usize;
+        (c0 < c1 && r0 < r1).then_some([c0, r0, c1, r1])
+    }
+
+    /// Grows the grid (whole blocks, a cell of margin) to hold the box [lo, hi] of the sensor
+    /// and every beam's end point: not the full range circle, so a scan in a corridor does not
     /// allocate the space beyond its walls.
-    fn grow_around(&mut self, p: [f64; 2], beams: &[([f32; 2], f32, bool)]) {
-        let (mut lo, mut hi) = (p, p);
-        for &(d, len, _) in beams {
-            let e = [p[0] + (d[0] * len) as f64, p[1] + (d[1] * len) as f64];
-            lo = [lo[0].min(e[0]), lo[1].min(e[1])];
-            hi = [hi[0].max(e[0]), hi[1].max(e[1])];
-        }
+    fn grow_to_hold(&mut self, lo: [f64; 2], hi: [f64; 2]) {
         let [c0, r0] = self.extent.cell_coords(lo[0], lo[1]);
         let [c1, r1] = self.extent.cell_coords(hi[0], hi[1]);
         let want = [c0 - 1, r0 - 1, c1 + 2, r1 + 2];
@@ -325,3 +336,14 @@ impl LogOddsMap {
 #[cfg(test)]
 #[path = "occupancy_tests.rs"]
 mod tests;
+
+/// The bounding box of the sensor at `p` and every beam's end point.
+fn beam_box(p: [f64; 2], beams: &[([f32; 2], f32, bool)]) -> ([f64; 2], [f64; 2]) {
+    let (mut lo, mut hi) = (p, p);
+    for &(d, len, _) in beams {
+        let e = [p[0] + (d[0] * len) as f64, p[1] + (d[1] * len) as f64];
+        lo = [lo[0].min(e[0]), lo[1].min(e[1])];
+        hi = [hi[0].max(e[0]), hi[1].max(e[1])];
+    }
+    (lo, hi)
+}

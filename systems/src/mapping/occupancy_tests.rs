@@ -234,3 +234,35 @@ fn exported_map_round_trips_through_map_server_files() {
     let loaded = load_map(&path).unwrap();
     assert_eq!(loaded, grid);
 }
+
+#[test]
+fn the_reported_window_holds_every_cell_a_scan_changed() {
+    let g = room();
+    let mut map = LogOddsMap::new(0.1, OccupancyParams::default());
+    map.insert_scan(
+        &Pose2::new(1.0, 1.0, 0.0),
+        &cast(&g, &Pose2::new(1.0, 1.0, 0.0)),
+    );
+    let before = map.log_odds().to_vec();
+    let (w, h) = (map.width(), map.height());
+    // a second scan from elsewhere in the room, without growing the map
+    let pose = Pose2::new(3.5, 0.5, 1.0);
+    let stats = map.insert_scan(&pose, &cast(&g, &pose));
+    assert_eq!((map.width(), map.height()), (w, h));
+    let [c0, r0, c1, r1] = stats.window.expect("the scan touched the map");
+    let mut changed = 0;
+    for (i, (a, b)) in before.iter().zip(map.log_odds()).enumerate() {
+        if a != b {
+            changed += 1;
+            let (c, r) = (i % w, i / w);
+            assert!(
+                (c0..c1).contains(&c) && (r0..r1).contains(&r),
+                "cell ({c}, {r}) outside {:?}",
+                [c0, r0, c1, r1]
+            );
+        }
+    }
+    assert!(changed > 100, "{changed}");
+    // and it is not the whole map: the box of what the scan reached
+    assert!((c1 - c0) * (r1 - r0) <= w * h);
+}
