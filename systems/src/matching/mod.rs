@@ -16,11 +16,16 @@
 //! * `normals`, `orientation`, `ref_grid`, `translation_search`, `refine`, `subsample`,
 //!   `improved` — the improved matcher's stages (private);
 //! * `matcher` — configuration and the entry point;
-//! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share.
+//! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share;
+//! * [`likelihood`] — an occupancy map blurred into a point-likelihood grid (Olson 2009);
+//! * [`branch_bound`] — real-time correlative scan matching by branch-and-bound over
+//!   precomputed max grids (Hess et al. 2016 §V, Olson 2009), the loop-closure matcher.
 
+pub mod branch_bound;
 pub mod correlation;
 pub mod de;
 pub mod euclidean;
+pub mod likelihood;
 pub mod prob_grid;
 pub mod scan_points;
 
@@ -39,11 +44,15 @@ mod visibility;
 #[cfg(test)]
 mod tests;
 
+pub use branch_bound::{
+    BnbMatch, BnbWindow, PrecomputedGrids, angular_step, match_bnb, match_exhaustive,
+};
 pub use correlation::{CorrelationFitness, RasterSpec};
 pub use de::{Bounds, Crossover, DeOutcome, DeParams, StallStop, StopReason, Strategy, Vector};
 pub use error::MatchError;
 pub use euclidean::{EuclideanField, euclidean_brute};
 pub use improved::ImprovedConfig;
+pub use likelihood::likelihood_grid;
 pub use matcher::{
     MatchConfig, MatchResult, Method, SearchWindow, ThesisConfig, ThesisFitness, match_scans,
     match_scans_with_rng,
