@@ -9,6 +9,7 @@ pub mod body;
 pub mod core;
 pub mod eval;
 pub mod localization;
+pub mod mapping;
 pub mod matching;
 pub mod navigation;
 pub mod raycast;
