@@ -29,7 +29,7 @@ pub use mcl::{Mcl, MclConfig, PoseEstimate};
 pub use motion_model::OdometryMotionModel;
 pub use nav_source::NavSource;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};
-pub use scan_estimator::ScanEstimator;
+pub use scan_estimator::{GraphEdgeKind, GraphEdgeView, GraphView, ScanEstimator};
 
 use crate::core::{SimPlugin, SimSet};
 use bevy_ecs::prelude::*;

@@ -10,12 +10,15 @@
 //! * [`matched_map`] — a map matched against and inserted into scan after scan (map, mirror,
 //!   pyramid);
 //! * [`scan_to_map`] — scan-to-map SLAM (Hector-style Gauss-Newton with an odometry prior);
+//! * [`pose_graph`] — sparse pose adjustment on SE(2) with a Huber kernel, the back end of
+//!   graph-based SLAM;
 //! * `grow` — a grid's extent on a fixed cell lattice and growth by whole blocks (private).
 
 pub mod align;
 mod grow;
 pub mod matched_map;
 pub mod occupancy;
+pub mod pose_graph;
 pub mod quality;
 pub mod scan_to_map;
 

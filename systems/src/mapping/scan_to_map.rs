@@ -99,6 +99,8 @@ pub struct ScanToMapSlam {
     last_odom: Option<Pose2>,
     last_insert: Option<Pose2>,
     pub estimate: Option<PoseEstimate>,
+    /// Every scan's (stamp, pose).
+    pub path: Vec<(f64, Pose2)>,
     /// Matches run, and those that did not converge.
     pub matches: usize,
     pub unconverged: usize,
@@ -114,6 +116,7 @@ impl ScanToMapSlam {
             last_odom: None,
             last_insert: None,
             estimate: None,
+            path: Vec::new(),
             matches: 0,
             unconverged: 0,
         }
@@ -171,6 +174,7 @@ impl ScanToMapSlam {
             covariance,
             weight: 1.0,
         });
+        self.path.push((scan.stamp, self.pose));
     }
 }
 
@@ -186,6 +190,14 @@ impl ScanEstimator for ScanToMapSlam {
 
     fn estimate(&self) -> Option<PoseEstimate> {
         self.estimate
+    }
+
+    fn map(&self) -> Option<ProbGrid> {
+        (self.map.scans > 0).then(|| self.map.prob().clone())
+    }
+
+    fn trajectory(&self) -> Vec<(f64, Pose2)> {
+        self.path.clone()
     }
 
     fn box_clone(&self) -> Box<dyn ScanEstimator> {

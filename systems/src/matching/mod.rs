@@ -19,12 +19,17 @@
 //! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share;
 //! * [`map_pyramid`] — its multi-resolution form for Gauss-Newton matching (Hector SLAM, §IV.C);
 //! * [`gauss_newton`] — Hector-style scan-to-map matching, [`match_scan`]`(pyramid, points,
-//!   initial, prior, &params) -> GnResult` (Kohlbrecher et al., SSRR 2011, §IV).
+//!   initial, prior, &params) -> GnResult` (Kohlbrecher et al., SSRR 2011, §IV);
+//! * [`likelihood`] — an occupancy map blurred into a point-likelihood grid (Olson 2009);
+//! * [`branch_bound`] — real-time correlative scan matching by branch-and-bound over
+//!   precomputed max grids (Hess et al. 2016 §V, Olson 2009), the loop-closure matcher.
 
+pub mod branch_bound;
 pub mod correlation;
 pub mod de;
 pub mod euclidean;
 pub mod gauss_newton;
+pub mod likelihood;
 pub mod map_pyramid;
 pub mod prob_grid;
 pub mod scan_points;
@@ -44,12 +49,16 @@ mod visibility;
 #[cfg(test)]
 mod tests;
 
+pub use branch_bound::{
+    BnbMatch, BnbWindow, PrecomputedGrids, angular_step, match_bnb, match_exhaustive,
+};
 pub use correlation::{CorrelationFitness, RasterSpec};
 pub use de::{Bounds, Crossover, DeOutcome, DeParams, StallStop, StopReason, Strategy, Vector};
 pub use error::MatchError;
 pub use euclidean::{EuclideanField, euclidean_brute};
 pub use gauss_newton::{GaussNewtonParams, GnResult, OdometryPrior, match_scan};
 pub use improved::ImprovedConfig;
+pub use likelihood::likelihood_grid;
 pub use map_pyramid::{
     Combine, MapPyramid, MapSample, PyramidLevel, PyramidOptions, Surfaces, UPDATE_TILE,
 };
