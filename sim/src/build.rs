@@ -9,7 +9,7 @@ use systems::body::{
     PhysicsPlugin, TruePose, TrueTwist, Walker,
 };
 use systems::core::{
-    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimSet, new_schedule, stream_rng,
+    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimRng, SimSet, new_schedule, stream_rng,
 };
 use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome, RobotMetrics};
 use systems::localization::de_filter::DeFilter;
@@ -17,7 +17,7 @@ use systems::localization::de_mc::DeMc;
 use systems::localization::de_odometry::DeOdometry;
 use systems::localization::{
     Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
-    NavSource, OdometryModel, WheelOdometry,
+    NavSource, OdometryModel, ScanEstimator, WheelOdometry,
 };
 use systems::mapping::{MappingPlugin, ScanToMapSlam};
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
@@ -89,7 +89,7 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
     let mut robots = Vec::with_capacity(scenario.robots.len());
     for (i, r) in scenario.robots.iter().enumerate() {
         let body = physics.add_robot(i as u32, &r.start, &r.footprint);
-        let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body);
+        let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body)?;
         if let (Some(nav), Some(maps)) = (&r.navigation, &costmaps) {
             let mut params = nav.params.clone();
             params.costmap = maps.index_of(&nav.costmap).unwrap_or(0);
@@ -187,7 +187,7 @@ fn spawn_robot(
     index: u32,
     r: &RobotConfig,
     body: systems::body::PhysicsBody,
-) -> Entity {
+) -> anyhow::Result<Entity> {
     let half_width = r.footprint.bounding_radius() + 0.1;
     let mut behaviour = Behaviour::new(
         r.behaviour.clone(),
@@ -250,33 +250,54 @@ fn spawn_robot(
                 .iter()
                 .map(|l| {
                     let rng = stream_rng(seed, &r.name, &format!("localizer/{}", l.name));
-                    let filter = match &l.kind {
-                        LocalizerKind::Mcl(c) => {
-                            Filter::Mcl(Box::new(Mcl::new(c.clone(), map, rng)))
-                        }
-                        LocalizerKind::MarkovGrid(c) => {
-                            Filter::MarkovGrid(Box::new(MarkovGrid::new(c.clone(), map)))
-                        }
-                        LocalizerKind::DeFilter(c) => {
-                            Filter::DeFilter(Box::new(DeFilter::new(c.clone(), map, rng)))
-                        }
-                        LocalizerKind::DeMc(c) => {
-                            Filter::DeMc(Box::new(DeMc::new(c.clone(), map, rng)))
-                        }
-                        LocalizerKind::DeOdometry(c) => {
-                            Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
-                        }
-                        LocalizerKind::ScanToMap(c) => {
-                            Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone())))
-                        }
-                    };
-                    Localizer::new(l.name.clone(), filter)
+                    Ok(Localizer::new(
+                        l.name.clone(),
+                        new_filter(&l.kind, Some(map), rng)?,
+                    ))
                 })
-                .collect()
+                .collect::<anyhow::Result<_>>()?
         };
         world
             .entity_mut(id)
             .insert((Localizers { items }, LocalizationSamples::default()));
     }
-    id
+    Ok(id)
+}
+
+/// The localizer or SLAM system a resolved scenario entry describes, with its random stream
+/// (`stream_rng(seed, robot, "localizer/<name>")`). Map-based localizers need the map they
+/// localize in; SLAM systems ([`Filter::Scan`]) take none.
+pub fn new_filter(
+    kind: &LocalizerKind,
+    map: Option<&LocalizationMap>,
+    rng: SimRng,
+) -> anyhow::Result<Filter> {
+    let need_map =
+        || map.ok_or_else(|| anyhow::anyhow!("a localizer of this type needs the scenario's map"));
+    Ok(match kind {
+        LocalizerKind::Mcl(c) => Filter::Mcl(Box::new(Mcl::new(c.clone(), need_map()?, rng))),
+        LocalizerKind::MarkovGrid(c) => {
+            Filter::MarkovGrid(Box::new(MarkovGrid::new(c.clone(), need_map()?)))
+        }
+        LocalizerKind::DeFilter(c) => {
+            Filter::DeFilter(Box::new(DeFilter::new(c.clone(), need_map()?, rng)))
+        }
+        LocalizerKind::DeMc(c) => Filter::DeMc(Box::new(DeMc::new(c.clone(), need_map()?, rng))),
+        LocalizerKind::DeOdometry(c) => {
+            Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
+        }
+        LocalizerKind::ScanToMap(c) => Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()))),
+    })
+}
+
+/// The SLAM system a resolved `slam` entry describes (an error for other localizer kinds).
+pub fn new_scan_estimator(
+    kind: &LocalizerKind,
+    rng: SimRng,
+) -> anyhow::Result<Box<dyn ScanEstimator>> {
+    match new_filter(kind, None, rng) {
+        Ok(Filter::Scan(e)) => Ok(e),
+        Ok(f) => anyhow::bail!("`{}` is a localizer, not a SLAM system", f.kind()),
+        Err(e) => Err(e),
+    }
 }

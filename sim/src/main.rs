@@ -6,9 +6,10 @@ use sim::bench_loc::{LocBenchOptions, run_markov_grid_bench, run_mcl_bench};
 use sim::bench_match::{DeMatchBenchOptions, run_de_match_bench};
 use sim::experiment::de_match::{DeMatchOptions, run_de_match_experiment};
 use sim::match_cmd::{CrossoverArg, FitnessArg, MatchOptions, parse_strategy, run_match};
+use sim::run_cmd::{RunArgs, check_duration, run_command, scenario_arg};
 use sim::runner::ScanCapture;
-use sim::scenario::{DEFAULT_SCENARIO, bundled_scenarios, find_scenario, load_scenario};
-use sim::{RunOptions, run_scenario};
+use sim::scenario::{bundled_scenarios, load_scenario};
+use sim::slam_cmd::{SlamArgs, run_slam_command};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -26,37 +27,9 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scenario (a file, or the name of a bundled scenario; default: hospital_patrol).
-    Run {
-        scenario: Option<String>,
-        /// Override the scenario's seed.
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Override the scenario's duration (simulated seconds).
-        #[arg(long, allow_negative_numbers = true)]
-        duration: Option<f64>,
-        /// Where to write the Rerun recording (default: <scenario>-seed<N>.rrd here).
-        #[arg(long, conflicts_with = "no_rrd")]
-        rrd: Option<PathBuf>,
-        /// Do not write a recording.
-        #[arg(long)]
-        no_rrd: bool,
-        /// Write the summary as JSON to this file.
-        #[arg(long)]
-        summary: Option<PathBuf>,
-        /// Worker threads for parallel kernels (0 = one per core). Results do not depend on it.
-        #[arg(long, default_value_t = 0)]
-        threads: usize,
-        /// No progress bar and no table, only errors.
-        #[arg(long)]
-        quiet: bool,
-        /// Write ground truth and every localizer's estimates here in TUM format (for evo).
-        #[arg(long)]
-        trajectories: Option<PathBuf>,
-        /// Write the event log here: scenario events and navigation events (task started,
-        /// stops, re-plans, giving way, failures), one `time robot text` line each.
-        #[arg(long)]
-        log: Option<PathBuf>,
-    },
+    Run(RunArgs),
+    /// Run a SLAM system on a recorded CARMEN log (e.g. one written by `sim run --carmen-out`).
+    Slam(SlamArgs),
     /// List the bundled scenarios.
     Scenarios,
     /// Capture laser scans with their true sensor poses into a SCANS file (CSV, see README).
@@ -247,19 +220,6 @@ enum ExperimentCommand {
     },
 }
 
-/// A scenario file or the name of a bundled scenario (default: hospital_patrol).
-fn resolve_scenario(arg: Option<String>) -> anyhow::Result<sim::Scenario> {
-    let arg = arg.unwrap_or_else(|| DEFAULT_SCENARIO.to_string());
-    let path = find_scenario(&arg).ok_or_else(|| {
-        let names: Vec<String> = bundled_scenarios().into_iter().map(|(n, _)| n).collect();
-        anyhow::anyhow!(
-            "{arg}: no such file and no bundled scenario of that name (bundled: {})",
-            names.join(", ")
-        )
-    })?;
-    Ok(load_scenario(&path)?)
-}
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli.command) {
@@ -273,99 +233,8 @@ fn main() -> ExitCode {
 
 fn dispatch(cmd: Command) -> anyhow::Result<()> {
     match cmd {
-        Command::Run {
-            scenario,
-            seed,
-            duration,
-            rrd,
-            no_rrd,
-            summary,
-            threads,
-            quiet,
-            trajectories,
-            log,
-        } => {
-            let arg = scenario.unwrap_or_else(|| DEFAULT_SCENARIO.to_string());
-            let path = find_scenario(&arg).ok_or_else(|| {
-                let names: Vec<String> = bundled_scenarios().into_iter().map(|(n, _)| n).collect();
-                anyhow::anyhow!(
-                    "{arg}: no such file and no bundled scenario of that name (bundled: {})",
-                    names.join(", ")
-                )
-            })?;
-            let mut sc = load_scenario(&path)?;
-            if let Some(s) = seed {
-                sc.seed = s;
-            }
-            if let Some(d) = duration {
-                if !(d.is_finite() && d > 0.0) {
-                    anyhow::bail!("--duration: expected a positive number of seconds, got {d}");
-                }
-                sc.duration = d;
-            }
-            let rrd_path =
-                if no_rrd {
-                    None
-                } else {
-                    Some(rrd.unwrap_or_else(|| {
-                        PathBuf::from(format!("{}-seed{}.rrd", sc.name, sc.seed))
-                    }))
-                };
-            if !quiet {
-                eprintln!(
-                    "running {} ({} robots, {:.1} s simulated, seed {})",
-                    sc.name,
-                    sc.robots.len(),
-                    sc.duration,
-                    sc.seed
-                );
-            }
-            let out = run_scenario(
-                &sc,
-                &RunOptions {
-                    rrd: rrd_path.clone(),
-                    threads,
-                    progress: !quiet,
-                    trajectory_period: None,
-                },
-            )?;
-            if !quiet {
-                print!("{}", out.summary.table());
-                if let Some(p) = &rrd_path {
-                    println!(
-                        "recording written to {} (open it with: rerun {})",
-                        p.display(),
-                        p.display()
-                    );
-                }
-            }
-            if let Some(dir) = &trajectories {
-                let files = sim::record::write_trajectories(dir, &out.localization)?;
-                if !quiet {
-                    println!(
-                        "{} trajectory files written to {}",
-                        files.len(),
-                        dir.display()
-                    );
-                }
-            }
-            if let Some(p) = &log {
-                let mut text = String::new();
-                for (t, robot, what) in &out.log {
-                    let who = if robot.is_empty() { "-" } else { robot };
-                    text += &format!("{t:9.2} {who:<12} {what}\n");
-                }
-                std::fs::write(p, text)
-                    .map_err(|e| anyhow::anyhow!("{}: cannot write the log: {e}", p.display()))?;
-            }
-            if let Some(p) = summary {
-                let json = serde_json::to_string_pretty(&out.summary)?;
-                std::fs::write(&p, json + "\n").map_err(|e| {
-                    anyhow::anyhow!("{}: cannot write the summary: {e}", p.display())
-                })?;
-            }
-            Ok(())
-        }
+        Command::Run(args) => run_command(&args),
+        Command::Slam(args) => run_slam_command(&args).map(|_| ()),
         Command::Scenarios => {
             for (name, path) in bundled_scenarios() {
                 let desc = load_scenario(&path)
@@ -385,15 +254,12 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
             threads,
             quiet,
         } => {
-            let mut sc = resolve_scenario(scenario)?;
+            let mut sc = scenario_arg(scenario.as_deref())?;
             if let Some(s) = seed {
                 sc.seed = s;
             }
             if let Some(d) = duration {
-                if !(d.is_finite() && d > 0.0) {
-                    anyhow::bail!("--duration: expected a positive number of seconds, got {d}");
-                }
-                sc.duration = d;
+                sc.duration = check_duration(d)?;
             }
             if !(period.is_finite() && period > 0.0) {
                 anyhow::bail!("--period: expected a positive number of seconds, got {period}");

@@ -2,7 +2,9 @@
 //! progress (simulated time and real-time factor), records, and gathers the summary.
 
 use crate::build::{SimWorld, build_world};
+use crate::record::slam::{SlamRecording, record_slam, record_slam_final};
 use crate::record::{RrdRecorder, record_navigation, record_rrd};
+use crate::run_exports::{Exported, RunExports};
 use crate::scans::ScanRecord;
 use crate::scenario::Scenario;
 use crate::summary::{NavigationFailure, NavigationSummary, RobotSummary, Summary};
@@ -53,6 +55,8 @@ pub struct RunOutput {
     /// What happened, in time order: scenario events and every navigator's events
     /// (time, robot name or "" for world events, text).
     pub log: Vec<(f64, String, String)>,
+    /// The files [`run_scenario_exporting`] wrote.
+    pub exported: Exported,
 }
 
 /// True when the scenario asks to end once every robot with tasks is done, and they are.
@@ -110,7 +114,16 @@ fn truth_poses(w: &mut World) -> Vec<Pose2> {
 
 /// Runs a scenario to its end.
 pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<RunOutput> {
-    run(scenario, opts, None)
+    run(scenario, opts, None, &RunExports::default())
+}
+
+/// Runs a scenario to its end and writes the exports asked for (CARMEN logs, maps).
+pub fn run_scenario_exporting(
+    scenario: &Scenario,
+    opts: &RunOptions,
+    exports: &RunExports,
+) -> anyhow::Result<RunOutput> {
+    run(scenario, opts, None, exports)
 }
 
 /// Runs a scenario to its end and collects laser scans as `capture` asks.
@@ -143,7 +156,7 @@ pub fn run_scenario_capturing(
             }
         }
     }
-    run(scenario, opts, Some(capture))
+    run(scenario, opts, Some(capture), &RunExports::default())
 }
 
 /// Per-robot state of a scan capture.
@@ -198,6 +211,7 @@ fn run(
     scenario: &Scenario,
     opts: &RunOptions,
     capture: Option<&ScanCapture>,
+    exports: &RunExports,
 ) -> anyhow::Result<RunOutput> {
     let mut capturer = capture.map(|capture| Capturer {
         capture,
@@ -208,12 +222,15 @@ fn run(
     if let Some(path) = &opts.rrd {
         let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
         sim.world.insert_resource(rec);
+        sim.world
+            .insert_resource(SlamRecording::new(scenario.record.scan_rate));
         sim.schedule.add_systems(
-            (record_rrd, record_navigation)
+            (record_rrd, record_navigation, record_slam)
                 .chain()
                 .in_set(SimSet::Record),
         );
     }
+    exports.install(&mut sim, scenario)?;
     let ticks = (scenario.duration / scenario.dt).round().max(1.0) as u64;
     let bar = if opts.progress {
         let b = ProgressBar::new(ticks);
@@ -261,9 +278,13 @@ fn run(
     }
     bar.finish_and_clear();
     let wall_time_s = started.elapsed().as_secs_f64();
+    if sim.world.contains_resource::<RrdRecorder>() {
+        record_slam_final(&mut sim.world);
+    }
     if let Some(mut rec) = sim.world.remove_resource::<RrdRecorder>() {
         rec.finish()?;
     }
+    let exported = exports.finish(&mut sim.world, scenario)?;
     if opts.trajectory_period.is_some() {
         trajectory.push((sim.time(), truth_poses(&mut sim.world)));
     }
@@ -282,6 +303,7 @@ fn run(
         localization: robot_localization(&mut sim.world),
         scans: capturer.map(|c| c.scans).unwrap_or_default(),
         log: event_log(&mut sim.world),
+        exported,
     })
 }
 

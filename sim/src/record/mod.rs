@@ -3,7 +3,9 @@
 
 pub mod belief;
 pub mod navigation;
+pub mod replay;
 pub mod rrd;
+pub mod slam;
 pub mod tum;
 
 pub use navigation::record_navigation;

@@ -89,7 +89,7 @@ fn colour(index: u32) -> rerun::Color {
     rerun::Color::from_rgb(c[0], c[1], c[2])
 }
 
-fn push_point(path: &mut Vec<[f32; 3]>, p: &Pose2) {
+pub(super) fn push_point(path: &mut Vec<[f32; 3]>, p: &Pose2) {
     let q = [p.x as f32, p.y as f32, 0.0];
     match path.last() {
         Some(l) if ((l[0] - q[0]).powi(2) + (l[1] - q[1]).powi(2)).sqrt() < PATH_SPACING as f32 => {
@@ -106,19 +106,7 @@ impl RrdRecorder {
         grid: &OccupancyGrid,
         config: &RecordConfig,
     ) -> anyhow::Result<Self> {
-        // Chunks are cut by size, not by wall time (the default flushes every 200 ms of wall
-        // time, which gives a fast run thousands of tiny chunks of mostly metadata): a quarter
-        // of the file size for a run with localizers, and the same chunks whatever the speed.
-        let batcher = rerun::log::ChunkBatcherConfig {
-            flush_tick: std::time::Duration::from_secs(3600),
-            flush_num_bytes: 1024 * 1024,
-            ..rerun::log::ChunkBatcherConfig::DEFAULT
-        };
-        let rec = rerun::RecordingStreamBuilder::new("sim")
-            .recording_name(scenario_name)
-            .batcher_config(batcher)
-            .save(path)
-            .map_err(|e| anyhow::anyhow!("{}: cannot create the recording: {e}", path.display()))?;
+        let rec = open_recording(path, scenario_name)?;
         let mut r = RrdRecorder {
             rec,
             pose_timer: RateTimer::new(config.rate, 0.0),
@@ -144,10 +132,6 @@ impl RrdRecorder {
     }
 
     fn log_static_world(&mut self, grid: &OccupancyGrid) {
-        let res = self
-            .rec
-            .log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP());
-        self.check(res);
         // ROS nav_msgs/OccupancyGrid values, row 0 at the origin corner, as GridMap expects
         let data: Vec<u8> = grid
             .cells
@@ -171,15 +155,59 @@ impl RrdRecorder {
 
     /// Flushes everything to disk; returns the first error seen.
     pub fn finish(&mut self) -> anyhow::Result<()> {
-        let res = self.rec.flush_blocking();
-        if let Err(e) = res {
-            self.error.get_or_insert_with(|| e.to_string());
-        }
-        match self.error.take() {
-            Some(e) => Err(anyhow::anyhow!("writing the recording failed: {e}")),
-            None => Ok(()),
-        }
+        close_recording(&self.rec, self.error.take())
     }
+}
+
+/// Flushes a recording to disk; returns `error` (the first logging error seen) or the flush's.
+pub(super) fn close_recording(
+    rec: &rerun::RecordingStream,
+    error: Option<String>,
+) -> anyhow::Result<()> {
+    let flushed = rec.flush_blocking().map_err(|e| e.to_string());
+    match error.or(flushed.err()) {
+        Some(e) => Err(anyhow::anyhow!("writing the recording failed: {e}")),
+        None => Ok(()),
+    }
+}
+
+/// A scan's end points (+Inf and other non-returns left out) taken from `sensor`, the laser's
+/// pose in the frame drawn.
+pub(super) fn scan_cloud(
+    scan: &systems::sensors::LaserScan,
+    sensor: &Pose2,
+    c: rerun::Color,
+) -> rerun::Points3D {
+    let pts: Vec<[f32; 3]> = scan
+        .points()
+        .map(|p| {
+            let w = sensor.transform_point([p[0] as f64, p[1] as f64]);
+            [w[0] as f32, w[1] as f32, 0.0]
+        })
+        .collect();
+    rerun::Points3D::new(pts)
+        .with_radii([0.03])
+        .with_colors([c])
+}
+
+/// Opens an .rrd file for writing, z up (the floor plan seen from above).
+pub fn open_recording(path: &Path, name: &str) -> anyhow::Result<rerun::RecordingStream> {
+    // Chunks are cut by size, not by wall time (the default flushes every 200 ms of wall
+    // time, which gives a fast run thousands of tiny chunks of mostly metadata): a quarter
+    // of the file size for a run with localizers, and the same chunks whatever the speed.
+    let batcher = rerun::log::ChunkBatcherConfig {
+        flush_tick: std::time::Duration::from_secs(3600),
+        flush_num_bytes: 1024 * 1024,
+        ..rerun::log::ChunkBatcherConfig::DEFAULT
+    };
+    let rec = rerun::RecordingStreamBuilder::new("sim")
+        .recording_name(name)
+        .batcher_config(batcher)
+        .save(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot create the recording: {e}", path.display()))?;
+    rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
+        .map_err(|e| anyhow::anyhow!("{}: cannot write the recording: {e}", path.display()))?;
+    Ok(rec)
 }
 
 /// A GridMap of one byte per cell (row 0 at the origin corner, as ROS and GridMap expect).
@@ -461,17 +489,9 @@ pub fn record_rrd(
             && let Some((scans, lt)) = laser
             && let (Some(scan), Some(pose)) = (&scans.latest, &lt.latest)
         {
-            let pts: Vec<[f32; 3]> = scan
-                .points()
-                .map(|p| {
-                    let w = pose.transform_point([p[0] as f64, p[1] as f64]);
-                    [w[0] as f32, w[1] as f32, 0.0]
-                })
-                .collect();
-            let cloud = rerun::Points3D::new(pts)
-                .with_radii([0.03])
-                .with_colors([c]);
-            let res = r.rec.log(format!("{base}/scan"), &cloud);
+            let res = r
+                .rec
+                .log(format!("{base}/scan"), &scan_cloud(scan, pose, c));
             r.check(res);
         }
         if scans_due

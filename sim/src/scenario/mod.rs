@@ -13,6 +13,7 @@ pub mod places;
 pub mod resolve;
 pub mod sensors;
 pub mod slam;
+pub mod slam_file;
 pub mod sonar;
 
 pub use error::ScenarioError;

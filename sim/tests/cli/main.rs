@@ -1,5 +1,6 @@
 //! The `sim` command line: exit codes, error messages, default file names, the summary JSON.
 
+mod carmen;
 mod matching;
 
 use std::path::Path;
@@ -12,6 +13,17 @@ pub fn sim(args: &[&str], cwd: &Path) -> Output {
         .current_dir(cwd)
         .output()
         .expect("sim runs")
+}
+
+/// Runs `sim` and returns its standard output, failing with its standard error.
+pub fn run_ok(args: &[&str], cwd: &Path) -> String {
+    let out = sim(args, cwd);
+    assert!(
+        out.status.success(),
+        "{args:?} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 const ROOM: &str = r#"

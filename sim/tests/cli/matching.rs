@@ -3,6 +3,7 @@
 //! the documented fields, and every bad input the commands check ends with a clear message and a
 //! non-zero exit code (one test per case).
 
+use crate::run_ok;
 use crate::sim as sim_command;
 use sim::scans::{SCANS_HEADER, ScanRecord, read_scans};
 use std::path::{Path, PathBuf};
@@ -39,16 +40,6 @@ fn maze_scans() -> &'static Path {
         std::fs::rename(dir.join(&own), &file).unwrap();
         file
     })
-}
-
-fn run_ok(args: &[&str], cwd: &Path) -> String {
-    let out = sim_command(args, cwd);
-    assert!(
-        out.status.success(),
-        "{args:?} failed:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
 /// Runs `args`, expects a non-zero exit without a panic and every fragment in the message.

@@ -52,3 +52,58 @@ walls = [
   { from = [10.0, 0.0], to = [10.0, 10.0], thickness = 0.2 },
 ]
 "#;
+
+/// `sim run ARGS` as the binary runs it: Err (a non-zero exit) carries the message it prints.
+pub fn sim_run(args: &[&str]) -> Result<(), String> {
+    use sim::run_cmd::{RunArgs, parse_args, run_command};
+    let a: RunArgs = parse_args(args).map_err(|e| e.to_string())?;
+    run_command(&a).map_err(|e| format!("{e:#}"))
+}
+
+/// `sim slam ARGS` as the binary runs it, with its report.
+pub fn sim_slam(args: &[&str]) -> Result<sim::slam_cmd::report::SlamReport, String> {
+    use sim::run_cmd::parse_args;
+    use sim::slam_cmd::{SlamArgs, run_slam_command};
+    let a: SlamArgs = parse_args(args).map_err(|e| e.to_string())?;
+    run_slam_command(&a).map_err(|e| format!("{e:#}"))
+}
+
+/// Checks an .rrd with the Rerun 0.36.3 tools: `rerun rrd verify`, then the SDK's reader
+/// through check_rrd.py, whose JSON (entity paths, timelines, scalar statistics) it returns.
+pub fn check_rrd(path: &Path) -> serde_json::Value {
+    use std::process::Command;
+    let venv = rerun_venv();
+    let verify = Command::new(venv.join("bin/rerun"))
+        .args(["rrd", "verify"])
+        .arg(path)
+        .output()
+        .unwrap();
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify failed:\n{}\n{}",
+        String::from_utf8_lossy(&verify.stdout),
+        String::from_utf8_lossy(&verify.stderr)
+    );
+    let out = Command::new(venv.join("bin/python"))
+        .arg(repo_file("check_rrd.py"))
+        .arg(path)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&text).unwrap()
+}
+
+/// The entity paths of [`check_rrd`]'s answer.
+pub fn entity_paths(v: &serde_json::Value) -> Vec<String> {
+    v["entity_paths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|p| p.as_str().map(str::to_string))
+        .collect()
+}

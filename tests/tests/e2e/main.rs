@@ -3,6 +3,7 @@
 
 mod ackermann;
 mod blocked_by_person;
+mod carmen;
 mod common;
 mod determinism;
 mod events;

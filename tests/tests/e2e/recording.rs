@@ -23,20 +23,8 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
         },
     )
     .unwrap();
-    let venv = rerun_venv();
-    let rerun = venv.join("bin/rerun");
-    let verify = Command::new(&rerun)
-        .args(["rrd", "verify"])
-        .arg(&path)
-        .output()
-        .unwrap();
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify failed:\n{}\n{}",
-        String::from_utf8_lossy(&verify.stdout),
-        String::from_utf8_lossy(&verify.stderr)
-    );
-    let stats = Command::new(&rerun)
+    let v = check_rrd(&path);
+    let stats = Command::new(rerun_venv().join("bin/rerun"))
         .args(["rrd", "stats"])
         .arg(&path)
         .output()
@@ -46,24 +34,7 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
         "{}",
         String::from_utf8_lossy(&stats.stderr)
     );
-    let out = Command::new(venv.join("bin/python"))
-        .arg(repo_file("check_rrd.py"))
-        .arg(&path)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{text}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let paths: Vec<&str> = v["entity_paths"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|p| p.as_str())
-        .collect();
+    let paths = entity_paths(&v);
     let mut want = vec!["/world/map".to_string()];
     for r in &s.robots {
         for leaf in ["truth", "odometry", "scan"] {
@@ -93,7 +64,7 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
     }
     assert!(localizers >= 4, "the scenario should carry localizers");
     for w in &want {
-        assert!(paths.contains(&w.as_str()), "missing {w} in {paths:?}");
+        assert!(paths.contains(w), "missing {w} in {paths:?}");
     }
     // the error series: one value per published estimate, plausible for every localizer, and
     // small for MCL tracking from the known start pose

@@ -1,0 +1,133 @@
+//! `sim slam --carmen`, `sim run --carmen-out` and `--save-map` through the binary: exit codes,
+//! messages, printed counts and default file names.
+
+use super::{ROOM, expect_failure, run_ok};
+use std::path::Path;
+
+fn fixture(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/carmen")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+#[test]
+fn slam_on_a_malformed_log_exits_non_zero_naming_the_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    expect_failure(
+        &["slam", "--carmen", &fixture("malformed.log"), "--no-rrd"],
+        dir.path(),
+        &["malformed.log:5: FLASER", "expected 5 range readings"],
+    );
+    expect_failure(
+        &["slam", "--carmen", "nowhere.log"],
+        dir.path(),
+        &["nowhere.log", "cannot read"],
+    );
+}
+
+#[test]
+fn slam_prints_skipped_types_and_writes_the_default_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = run_ok(
+        &["slam", "--carmen", &fixture("unknown_types.log")],
+        dir.path(),
+    );
+    for want in [
+        "1 scans used",
+        "BUMP 1",
+        "NMEAGGA 1",
+        "POSITIONLASER 1",
+        "RAWLASER1 2",
+        "SONAR 1",
+        "SYNC 2",
+        "no TRUEPOS lines",
+        "real time",
+    ] {
+        assert!(text.contains(want), "expected `{want}` in:\n{text}");
+    }
+    assert!(dir.path().join("unknown_types-slam.rrd").exists());
+}
+
+#[test]
+fn slam_rejects_bad_options_with_the_flag_or_file_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = fixture("flaser_odom.log");
+    let base = ["slam", "--carmen", log.as_str(), "--no-rrd"];
+    fn with<'a>(base: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        base.iter().chain(extra).copied().collect()
+    }
+    expect_failure(
+        &with(&base, &["--slam", "nope"]),
+        dir.path(),
+        &["--slam", "unknown variant `nope`"],
+    );
+    expect_failure(&with(&base, &["--fov", "0"]), dir.path(), &["--fov"]);
+    expect_failure(
+        &with(&base, &["--max-range", "-2"]),
+        dir.path(),
+        &["--max-range"],
+    );
+    std::fs::write(dir.path().join("s.toml"), "# ok\nlevels = 9\n").unwrap();
+    expect_failure(
+        &with(&base, &["--slam-config", "s.toml"]),
+        dir.path(),
+        &["s.toml:2:", "`levels`"],
+    );
+    std::fs::write(dir.path().join("u.toml"), "\nspeed = 9\n").unwrap();
+    expect_failure(
+        &with(&base, &["--slam-config", "u.toml"]),
+        dir.path(),
+        &["u.toml:2:", "unknown field `speed`"],
+    );
+}
+
+#[test]
+fn run_exports_a_log_and_a_map_that_slam_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let text = run_ok(
+        &[
+            "run",
+            "tiny.toml",
+            "--no-rrd",
+            "--carmen-out",
+            "tiny.log",
+            "--save-map",
+            "room",
+        ],
+        dir.path(),
+    );
+    assert!(text.contains("CARMEN log written to tiny.log"), "{text}");
+    assert!(
+        text.contains("map of r1/known_poses written to room.yaml"),
+        "{text}"
+    );
+    assert!(text.contains("precision"), "{text}");
+    for f in ["tiny.log", "room.yaml", "room.pgm"] {
+        assert!(dir.path().join(f).exists(), "{f}");
+    }
+    run_ok(
+        &[
+            "slam",
+            "--carmen",
+            "tiny.log",
+            "--no-rrd",
+            "--summary",
+            "s.json",
+            "--save-map",
+            "slam.yaml",
+        ],
+        dir.path(),
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    // the Hokuyo fires at 10 Hz for 2 s
+    assert!(s["scans"].as_u64().unwrap() >= 19, "{s}");
+    assert!(
+        s["slam_metrics"]["ate_rmse_m"].as_f64().unwrap() < 0.05,
+        "{s}"
+    );
+    assert!(dir.path().join("slam.pgm").exists());
+}
