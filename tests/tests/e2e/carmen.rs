@@ -3,7 +3,6 @@
 //! parsed as the binary parses them (exit codes and printed text: sim/tests/cli/carmen.rs).
 
 use crate::common::*;
-use sim::scenario::load_scenario;
 use sim::{RunOptions, run_scenario};
 use systems::core::Pose2;
 use systems::mapping::map_quality;
@@ -15,9 +14,9 @@ use systems::world::map_file::load_map;
 fn a_run_exported_as_carmen_replays_through_slam() {
     let dir = tempfile::tempdir().unwrap();
     let p = |f: &str| dir.path().join(f).display().to_string();
-    let scenario = bundled("hospital_loop").display().to_string();
+    let file = bundled("hospital_loop").display().to_string();
     let args = [
-        scenario.as_str(),
+        file.as_str(),
         "--duration",
         "40",
         "--no-rrd",
@@ -31,13 +30,24 @@ fn a_run_exported_as_carmen_replays_through_slam() {
     ];
     sim_run(&args).unwrap();
 
-    // exporting never changes the run: the summary equals that of a plain run
-    let mut sc = load_scenario(&bundled("hospital_loop")).unwrap();
+    // the same run without exports, with scan-to-map SLAM inside the simulation (SLAM never
+    // steers the robot): exporting changed nothing but the SLAM entry it lacks
+    let text = std::fs::read_to_string(bundled("hospital_loop")).unwrap();
+    let mut sc = scenario(&text.replacen(
+        "# lap 1\n",
+        "[[robots.slam]]\ntype = \"scan_to_map\"\n# lap 1\n",
+        1,
+    ));
     sc.duration = 40.0;
-    let plain = run_scenario(&sc, &RunOptions::default()).unwrap();
+    let inside = run_scenario(&sc, &RunOptions::default()).unwrap();
     let exported: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(p("run.json")).unwrap()).unwrap();
-    let plain = serde_json::to_value(&plain.summary).unwrap();
+    let mut plain = serde_json::to_value(&inside.summary).unwrap();
+    let slam_entry = plain["robots"][0]["localization"]
+        .as_object_mut()
+        .unwrap()
+        .remove("scan_to_map");
+    assert!(slam_entry.is_some());
     assert_eq!(exported["robots"], plain["robots"]);
 
     // the robot has no SLAM: a known-pose map, judged against the true map (same frame)
@@ -73,8 +83,23 @@ fn a_run_exported_as_carmen_replays_through_slam() {
         odom.ate_rmse_m.unwrap() > 3.0 * ate,
         "odometry drifts: {odom:?}"
     );
+    // replaying the log reproduces the SLAM run inside the simulation, pose for pose (TUM
+    // files hold 6 decimals)
     let tum = std::fs::read_to_string(p("t.tum")).unwrap();
-    assert_eq!(tum.lines().count(), report.scans);
+    let replayed: Vec<Vec<f64>> = tum
+        .lines()
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let (_, online) = inside.localization[0]
+        .localizers
+        .iter()
+        .find(|(n, _)| n == "scan_to_map")
+        .unwrap();
+    assert_eq!(replayed.len(), online.len());
+    for (r, s) in replayed.iter().zip(online) {
+        let d = (r[1] - s.estimate.x).hypot(r[2] - s.estimate.y);
+        assert!((r[0] - s.t).abs() < 1e-6 && d < 1e-5, "{r:?} vs {s:?}");
+    }
     assert!(std::fs::read_to_string(p("t.truth.tum")).is_ok());
 
     // the SLAM map is in the odometry frame, which `sim run` starts at the true start pose
