@@ -19,7 +19,7 @@ use systems::localization::{
     Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
     NavSource, OdometryModel, WheelOdometry,
 };
-use systems::mapping::{MappingPlugin, ScanToMapSlam};
+use systems::mapping::{GraphSlam, MappingPlugin, ScanToMapSlam};
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
@@ -268,6 +268,9 @@ fn spawn_robot(
                         }
                         LocalizerKind::ScanToMap(c) => {
                             Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone())))
+                        }
+                        LocalizerKind::Graph(c) => {
+                            Filter::Scan(Box::new(GraphSlam::new((**c).clone())))
                         }
                     };
                     Localizer::new(l.name.clone(), filter)
