@@ -19,7 +19,7 @@ use systems::localization::{
     Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
     NavSource, OdometryModel, ScanEstimator, WheelOdometry,
 };
-use systems::mapping::{MappingPlugin, ScanToMapSlam};
+use systems::mapping::{GraphSlam, MappingPlugin, ScanToMapSlam};
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
@@ -287,6 +287,7 @@ pub fn new_filter(
             Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
         }
         LocalizerKind::ScanToMap(c) => Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()))),
+        LocalizerKind::Graph(c) => Filter::Scan(Box::new(GraphSlam::new((**c).clone()))),
     })
 }
 

@@ -14,8 +14,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 use systems::body::TruePose;
 use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
-use systems::eval::{LocalizationSamples, LocalizerMetrics, NavOutcome, RobotMetrics, Sample};
-use systems::localization::Localizers;
+use systems::eval::{
+    LocalizationSamples, LocalizerMetrics, NavOutcome, RobotMetrics, Sample, TrajectoryMetrics,
+    pair_with_truth,
+};
+use systems::localization::{Filter, Localizers};
 use systems::navigation::{Behaviour, NavStatus, Navigator};
 use systems::sensors::{LaserScans, LaserTruth};
 
@@ -222,8 +225,10 @@ fn run(
     if let Some(path) = &opts.rrd {
         let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
         sim.world.insert_resource(rec);
-        sim.world
-            .insert_resource(SlamRecording::new(scenario.record.scan_rate));
+        sim.world.insert_resource(SlamRecording::new(
+            scenario.record.scan_rate,
+            scenario.record.slam_rate,
+        ));
         sim.schedule.add_systems(
             (record_rrd, record_navigation, record_slam)
                 .chain()
@@ -277,6 +282,7 @@ fn run(
         }
     }
     bar.finish_and_clear();
+    finish_slam(&mut sim.world);
     let wall_time_s = started.elapsed().as_secs_f64();
     if sim.world.contains_resource::<RrdRecorder>() {
         record_slam_final(&mut sim.world);
@@ -307,6 +313,19 @@ fn run(
     })
 }
 
+/// The run is over: SLAM systems run their final optimization (before the recording's last
+/// frame and the summary read their results).
+fn finish_slam(w: &mut World) {
+    let mut q = w.query::<&mut Localizers>();
+    for mut locs in q.iter_mut(w) {
+        for l in locs.items.iter_mut() {
+            if let Filter::Scan(e) = &mut l.filter {
+                e.finish();
+            }
+        }
+    }
+}
+
 fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
     let mut q = w.query::<(
         &RobotIndex,
@@ -330,10 +349,12 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                             .iter()
                             .find(|(n, _)| *n == l.name)
                             .map_or(&[][..], |(_, s)| &s[..]);
-                        (
-                            l.name.clone(),
-                            LocalizerMetrics::from_samples(l.filter.kind(), s),
-                        )
+                        let mut m = LocalizerMetrics::from_samples(l.filter.kind(), s);
+                        if let Filter::Scan(e) = &l.filter {
+                            let paired = pair_with_truth(s, &e.trajectory());
+                            m.final_trajectory = Some(TrajectoryMetrics::from_samples(&paired));
+                        }
+                        (l.name.clone(), m)
                     })
                     .collect(),
                 None => Default::default(),

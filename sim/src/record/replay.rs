@@ -30,14 +30,20 @@ pub struct ReplayRecorder {
 }
 
 impl ReplayRecorder {
-    /// Opens `path` for SLAM system `slam` (the robot's only one) of robot `robot`.
-    pub fn create(path: &Path, robot: &str, slam: &str, t0: f64) -> anyhow::Result<Self> {
+    /// Opens `path` for SLAM system `slam` (the robot's only one) of robot `robot`, logging its
+    /// map, trajectory and graph `slam_rate` times per second of log time (0: at the end).
+    pub fn create(
+        path: &Path,
+        robot: &str,
+        slam: &str,
+        (t0, slam_rate): (f64, f64),
+    ) -> anyhow::Result<Self> {
         Ok(ReplayRecorder {
             rec: open_recording(path, robot)?,
             robot: robot.to_string(),
             base: slam_entity(robot, slam, 1),
             t0,
-            track: SlamTrack::default(),
+            track: SlamTrack::new(slam_rate),
             scan_at: None,
             odometry: Vec::new(),
             truth: Vec::new(),

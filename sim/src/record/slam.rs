@@ -4,7 +4,8 @@
 //!
 //! - `…/map`: the map built so far (GridMap in the SLAM's map frame, P(occupied) as ROS
 //!   percentages with RViz colours, never-observed cells unknown), every [`MAP_PERIOD_S`] of
-//!   simulated time and at the end, so it grows over the timeline;
+//!   simulated time (`[record] slam_rate`, `sim slam --slam-rate`) and at the end, so it grows
+//!   over the timeline;
 //! - `…/trajectory`: the SLAM's best trajectory so far (line strip; optimized for graph SLAM);
 //! - `…/graph`: the pose-graph edges, for systems that keep a graph: sequential and local edges
 //!   thin grey, accepted loop closures thick bright green, rejected candidates red; and
@@ -13,7 +14,10 @@
 //!   scan rate.
 //!
 //! Map, trajectory and graph share one cadence: each is re-logged whole, so their cost is one
-//! copy of the map every 2 s however fast the SLAM runs.
+//! copy of the map every 2 s however fast the SLAM runs — plus whatever the SLAM system spends
+//! to produce its map: graph SLAM rebuilds its map from every node's scan after each
+//! optimization, which doubles the CPU time of a recorded hospital_loop run at the default rate
+//! (lower `slam_rate` for long graph SLAM runs).
 
 use super::rrd::{RrdRecorder, grid_map, scan_cloud};
 use bevy_ecs::prelude::*;
@@ -24,7 +28,8 @@ use systems::localization::{Filter, GraphEdgeKind, GraphView, Localizers, ScanEs
 use systems::matching::ProbGrid;
 use systems::sensors::{Laser, LaserScan, LaserScans};
 
-/// Seconds of simulated (or log) time between two logs of a SLAM's map, trajectory and graph.
+/// Default seconds of simulated (or log) time between two logs of a SLAM's map, trajectory and
+/// graph (`[record] slam_rate` sets it in scenarios).
 pub const MAP_PERIOD_S: f64 = 2.0;
 
 /// Height of SLAM maps: just above `world/map` (z = −0.01), below everything else.
@@ -134,16 +139,33 @@ pub fn log_slam_scan(
     rec.log(format!("{base}/scan"), &scan_cloud(scan, sensor, orange))
 }
 
-/// When a SLAM system's state was last logged.
-#[derive(Clone, Debug, Default)]
+/// When a SLAM system's state was last logged, and how often it is.
+#[derive(Clone, Debug)]
 pub struct SlamTrack {
+    /// Seconds between logs (infinite: only at the end).
+    period: f64,
     state_at: Option<f64>,
 }
 
 impl SlamTrack {
+    /// Logs `rate` times per second (0: none until the end).
+    pub fn new(rate: f64) -> Self {
+        SlamTrack {
+            period: if rate > 0.0 {
+                1.0 / rate
+            } else {
+                f64::INFINITY
+            },
+            state_at: None,
+        }
+    }
+
     /// True (and remembered) when the state is due at time `t`.
     pub fn state_due(&mut self, t: f64) -> bool {
-        let due = self.state_at.is_none_or(|a| t - a >= MAP_PERIOD_S - 1e-9);
+        if self.period.is_infinite() {
+            return false;
+        }
+        let due = self.state_at.is_none_or(|a| t - a >= self.period - 1e-9);
         if due {
             self.state_at = Some(t);
         }
@@ -155,16 +177,18 @@ impl SlamTrack {
 #[derive(Resource)]
 pub struct SlamRecording {
     scan_timer: RateTimer,
+    slam_rate: f64,
     due: Vec<f64>,
     /// (robot index, localizer index) → track.
     tracks: Vec<((u32, usize), SlamTrack)>,
 }
 
 impl SlamRecording {
-    /// Scans at `scan_rate` per second (the scenario's `[record] scan_rate`).
-    pub fn new(scan_rate: f64) -> Self {
+    /// Scans at `scan_rate` per second, the rest at `slam_rate` (the scenario's `[record]`).
+    pub fn new(scan_rate: f64, slam_rate: f64) -> Self {
         SlamRecording {
             scan_timer: RateTimer::new(scan_rate, 0.0),
+            slam_rate,
             due: Vec::new(),
             tracks: Vec::new(),
         }
@@ -174,7 +198,7 @@ impl SlamRecording {
         let i = match self.tracks.iter().position(|(k, _)| *k == key) {
             Some(i) => i,
             None => {
-                self.tracks.push((key, SlamTrack::default()));
+                self.tracks.push((key, SlamTrack::new(self.slam_rate)));
                 self.tracks.len() - 1
             }
         };
@@ -290,11 +314,13 @@ mod tests {
 
     #[test]
     fn state_is_due_every_period() {
-        let mut t = SlamTrack::default();
+        let mut t = SlamTrack::new(1.0 / MAP_PERIOD_S);
         let due: Vec<bool> = [0.0, 1.0, 1.99999999999, 2.5, 4.0]
             .iter()
             .map(|&x| t.state_due(x))
             .collect();
         assert_eq!(due, vec![true, false, true, false, true]);
+        let mut end_only = SlamTrack::new(0.0);
+        assert!(!end_only.state_due(0.0) && !end_only.state_due(100.0));
     }
 }

@@ -77,6 +77,8 @@ pub struct RecordFile {
     pub particle_rate: Option<f64>,
     /// At most this many points per logged particle set.
     pub particle_points: Option<usize>,
+    /// SLAM maps, trajectories and pose graphs per second (0: only at the end).
+    pub slam_rate: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]

@@ -74,6 +74,8 @@ pub struct RecordConfig {
     pub particle_rate: f64,
     /// At most this many points per logged particle set (subsampled).
     pub particle_points: usize,
+    /// SLAM maps, trajectories and pose graphs per second (0: only at the end of the run).
+    pub slam_rate: f64,
 }
 
 impl Default for RecordConfig {
@@ -84,6 +86,7 @@ impl Default for RecordConfig {
             path_rate: 1.0,
             particle_rate: 2.0,
             particle_points: 1000,
+            slam_rate: 0.5,
         }
     }
 }

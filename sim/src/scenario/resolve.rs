@@ -244,6 +244,10 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             d.particle_rate,
         )?,
         particle_points: rec.particle_points.unwrap_or(d.particle_points),
+        slam_rate: match rec.slam_rate {
+            Some(v) => c.range(&rp.key("slam_rate"), v, Some(0.0), None, false)?,
+            None => d.slam_rate,
+        },
     };
 
     // --- robots

@@ -7,8 +7,8 @@ use super::localizers::{LocalizerConfig, LocalizerKind};
 use super::resolve::{Checker, R};
 use serde::Deserialize;
 use systems::core::Pose2;
-use systems::mapping::ScanToMapConfig;
 use systems::mapping::scan_to_map::OdometryPriorModel;
+use systems::mapping::{GraphSlamConfig, ScanToMapConfig};
 
 #[derive(Debug)]
 pub enum SlamList {
@@ -55,12 +55,14 @@ impl SlamList {
 #[serde(rename_all = "snake_case")]
 pub enum SlamType {
     ScanToMap,
+    Graph,
 }
 
 impl SlamType {
     fn name(self) -> &'static str {
         match self {
             SlamType::ScanToMap => "scan_to_map",
+            SlamType::Graph => "graph",
         }
     }
 }
@@ -179,10 +181,14 @@ pub(super) fn resolve_slam(
             },
             init_pose: *start,
         };
-        out.push(LocalizerConfig {
-            name,
-            kind: LocalizerKind::ScanToMap(Box::new(config)),
-        });
+        let kind = match s.kind {
+            SlamType::ScanToMap => LocalizerKind::ScanToMap(Box::new(config)),
+            SlamType::Graph => LocalizerKind::Graph(Box::new(GraphSlamConfig {
+                local: config,
+                ..GraphSlamConfig::default()
+            })),
+        };
+        out.push(LocalizerConfig { name, kind });
     }
     Ok(out)
 }

@@ -54,6 +54,9 @@ pub struct SlamArgs {
     /// Do not write a recording.
     #[arg(long)]
     pub no_rrd: bool,
+    /// SLAM maps, trajectories and graphs recorded per second of log time (0: only the last).
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    pub slam_rate: f64,
     /// Save the final map as map_server YAML + PGM (`.yaml` added when missing).
     #[arg(long)]
     pub save_map: Option<PathBuf>,
@@ -97,6 +100,12 @@ pub fn robot_name(log: &Path) -> String {
 }
 
 fn read_options(a: &SlamArgs) -> anyhow::Result<CarmenReadOptions> {
+    if !(a.slam_rate.is_finite() && a.slam_rate >= 0.0) {
+        anyhow::bail!(
+            "--slam-rate: expected a number of logs per second ≥ 0, got {}",
+            a.slam_rate
+        );
+    }
     if let Some(f) = a.fov
         && !(f.is_finite() && f > 0.0 && f <= 360.0)
     {
@@ -177,7 +186,12 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
             .unwrap_or_else(|| PathBuf::from(format!("{robot}-slam.rrd")))
     });
     let mut rec = match &rrd {
-        Some(p) => Some(ReplayRecorder::create(p, &robot, &config.name, t0)?),
+        Some(p) => Some(ReplayRecorder::create(
+            p,
+            &robot,
+            &config.name,
+            (t0, a.slam_rate),
+        )?),
         None => None,
     };
     if !a.quiet {
@@ -191,11 +205,13 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     }
     let bar = progress(a.quiet, scans.len());
     let started = Instant::now();
-    let mut estimates = 0;
+    let mut online: Vec<(f64, Pose2)> = Vec::with_capacity(scans.len());
     for (k, s) in scans.iter().enumerate() {
         let scan = s.to_laser_scan();
-        if pool.install(|| est.update(&scan, &s.mount, &s.robot_pose)) && est.estimate().is_some() {
-            estimates += 1;
+        if pool.install(|| est.update(&scan, &s.mount, &s.robot_pose))
+            && let Some(e) = est.estimate()
+        {
+            online.push((s.timestamp, e.pose));
         }
         if let Some(r) = rec.as_mut() {
             let at = (s.timestamp, &s.robot_pose, truth.at(s.timestamp), &s.mount);
@@ -205,6 +221,8 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
             bar.set_position(k as u64 + 1);
         }
     }
+    // a smoother's final optimization is part of the run
+    pool.install(|| est.finish());
     bar.finish_and_clear();
     let wall_time_s = started.elapsed().as_secs_f64();
     if let Some(r) = rec {
@@ -219,7 +237,7 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
         slam: config.name.clone(),
         slam_type: est.kind().to_string(),
         scans: scans.len(),
-        estimates,
+        estimates: online.len(),
         rear_scans: log.rear_scans.len(),
         odometry_records: log.odometry.len(),
         truth_records: log.truth.len(),
@@ -227,7 +245,7 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
         log_duration_s: t1 - t0,
         wall_time_s,
         real_time_factor: (t1 - t0) / wall_time_s.max(1e-9),
-        slam_metrics: truth.metrics(est.kind(), &trajectory),
+        slam_metrics: truth.slam_metrics(est.kind(), &online, &trajectory),
         odometry_metrics: truth.metrics("odometry", &odometry),
         map: map.as_ref().map(|m| MapInfo {
             width: m.width,

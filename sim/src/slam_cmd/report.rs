@@ -35,7 +35,8 @@ pub struct SlamReport {
     pub wall_time_s: f64,
     /// Log duration / wall time.
     pub real_time_factor: f64,
-    /// The SLAM trajectory against TRUEPOS (None without TRUEPOS lines).
+    /// The SLAM system's estimates, published scan by scan, against TRUEPOS, with its final
+    /// trajectory's figures in `final_trajectory` (None without TRUEPOS lines).
     pub slam_metrics: Option<LocalizerMetrics>,
     /// The logged odometry at the scans against TRUEPOS.
     pub odometry_metrics: Option<LocalizerMetrics>,
@@ -92,6 +93,17 @@ impl SlamReport {
                     metric(m.rpe_rot_rad, "rad"),
                     m.estimates
                 );
+                if let Some(f) = &m.final_trajectory {
+                    let _ = writeln!(
+                        s,
+                        "{:<12} final trajectory: ATE {}  RPE {} / {}  ({} poses)",
+                        "",
+                        metric(f.ate_rmse_m, "m"),
+                        metric(f.rpe_trans_m, "m"),
+                        metric(f.rpe_rot_rad, "rad"),
+                        f.poses
+                    );
+                }
             }
         }
         if self.truth_records == 0 {

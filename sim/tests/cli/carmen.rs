@@ -131,3 +131,27 @@ fn run_exports_a_log_and_a_map_that_slam_reads_back() {
     );
     assert!(dir.path().join("slam.pgm").exists());
 }
+
+#[test]
+fn slam_rates_must_not_be_negative() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = fixture("flaser_odom.log");
+    expect_failure(
+        &["slam", "--carmen", &log, "--slam-rate", "-1"],
+        dir.path(),
+        &["--slam-rate"],
+    );
+    std::fs::write(
+        dir.path().join("r.toml"),
+        format!("{ROOM}[record]\nslam_rate = -1\n"),
+    )
+    .unwrap();
+    expect_failure(
+        &["run", "r.toml"],
+        dir.path(),
+        &[
+            "r.toml:",
+            "`record.slam_rate`: expected a number of at least 0",
+        ],
+    );
+}

@@ -37,6 +37,52 @@ pub struct LocalizerMetrics {
     pub tracked_fraction: Option<f64>,
     /// Position error of the last estimate (m).
     pub final_error_m: Option<f64>,
+    /// For SLAM systems: ATE and RPE of the trajectory the system holds at the end of the run
+    /// (for graph SLAM, after its last optimization; for filters, the poses they published).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub final_trajectory: Option<TrajectoryMetrics>,
+}
+
+/// ATE/RPE of a whole trajectory (same definitions as [`LocalizerMetrics`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TrajectoryMetrics {
+    pub poses: usize,
+    pub ate_rmse_m: Option<f64>,
+    pub rpe_trans_m: Option<f64>,
+    pub rpe_rot_rad: Option<f64>,
+}
+
+impl TrajectoryMetrics {
+    pub fn from_samples(samples: &[Sample]) -> Self {
+        let rpe = trajectory::rpe_consecutive(samples);
+        TrajectoryMetrics {
+            poses: samples.len(),
+            ate_rmse_m: trajectory::ate_align_origin(samples),
+            rpe_trans_m: rpe.map(|r| r.0),
+            rpe_rot_rad: rpe.map(|r| r.1),
+        }
+    }
+}
+
+/// `trajectory` (stamp, pose) paired with the true poses of `samples` at the same stamps (the
+/// online samples of the same estimator, which hold the truth at every scan it consumed);
+/// stamps without a sample are left out.
+pub fn pair_with_truth(
+    samples: &[Sample],
+    trajectory: &[(f64, crate::core::Pose2)],
+) -> Vec<Sample> {
+    trajectory
+        .iter()
+        .filter_map(|&(t, pose)| {
+            let i = samples.partition_point(|s| s.t < t - 1e-9);
+            let s = samples.get(i).filter(|s| (s.t - t).abs() <= 1e-9)?;
+            Some(Sample {
+                t,
+                estimate: pose,
+                truth: s.truth,
+            })
+        })
+        .collect()
 }
 
 /// The samples the ATE/RPE figures (and the written trajectories) use.
@@ -62,6 +108,7 @@ impl LocalizerMetrics {
             converged_after_s: conv.map(|i| samples[i].t),
             tracked_fraction: trajectory::tracked_fraction(samples),
             final_error_m: samples.last().map(Sample::position_error),
+            final_trajectory: None,
         }
     }
 }

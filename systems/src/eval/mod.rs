@@ -6,7 +6,9 @@ pub mod navigation_metrics;
 pub mod robot_metrics;
 pub mod trajectory;
 
-pub use localization_metrics::{LocalizationSamples, LocalizerMetrics, judged_samples};
+pub use localization_metrics::{
+    LocalizationSamples, LocalizerMetrics, TrajectoryMetrics, judged_samples, pair_with_truth,
+};
 pub use navigation_metrics::NavOutcome;
 pub use robot_metrics::RobotMetrics;
 pub use trajectory::Sample;

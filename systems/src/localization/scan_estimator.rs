@@ -19,6 +19,9 @@ pub trait ScanEstimator: Send + Sync + Debug {
     fn update(&mut self, scan: &LaserScan, mount: &Pose2, odom: &Pose2) -> bool;
     /// The latest estimate.
     fn estimate(&self) -> Option<PoseEstimate>;
+    /// The run is over: a smoother runs its final optimization here (call once, before reading
+    /// [`ScanEstimator::trajectory`] and [`ScanEstimator::map`] for the results).
+    fn finish(&mut self) {}
     /// The map built so far, P(occupied) per cell in the map frame (0.5 unknown); None before
     /// the first scan or for estimators without a map.
     fn map(&self) -> Option<ProbGrid> {

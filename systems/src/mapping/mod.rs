@@ -10,11 +10,14 @@
 //! * [`matched_map`] — a map matched against and inserted into scan after scan (map, mirror,
 //!   pyramid);
 //! * [`scan_to_map`] — scan-to-map SLAM (Hector-style Gauss-Newton with an odometry prior);
+//! * [`graph_slam`] — graph SLAM: submaps, branch-and-bound loop closure, pose-graph optimization
+//!   (Cartographer-style);
 //! * [`pose_graph`] — sparse pose adjustment on SE(2) with a Huber kernel, the back end of
 //!   graph-based SLAM;
 //! * `grow` — a grid's extent on a fixed cell lattice and growth by whole blocks (private).
 
 pub mod align;
+pub mod graph_slam;
 mod grow;
 pub mod matched_map;
 pub mod occupancy;
@@ -29,6 +32,7 @@ pub use align::{refine_alignment, start_pose_alignment};
 pub use occupancy::{InsertStats, LogOddsMap, OccupancyParams};
 pub use quality::{MapQuality, map_quality, quality_with_start_pose};
 
+pub use graph_slam::{GraphSlam, GraphSlamConfig};
 pub use scan_to_map::{ScanToMapConfig, ScanToMapSlam};
 
 use crate::core::{KernelPool, SimPlugin, SimSet};

@@ -63,7 +63,7 @@ impl Default for ScanToMapConfig {
         ScanToMapConfig {
             resolution: 0.05,
             levels: 3,
-            occupancy: OccupancyParams::default(),
+            occupancy: OccupancyParams::slam(),
             matcher: GaussNewtonParams::default(),
             map_update_min_d: 0.2,
             map_update_min_a: 0.15,
@@ -77,17 +77,19 @@ impl Default for ScanToMapConfig {
 impl OdometryPriorModel {
     /// The prior on `predicted` after odometry moved by `delta`.
     pub fn prior(&self, predicted: Pose2, delta: &Pose2) -> OdometryPrior {
+        OdometryPrior::from_std(predicted, self.std(delta))
+    }
+
+    /// The standard deviations [x, y, θ] after a motion `delta`.
+    pub fn std(&self, delta: &Pose2) -> [f64; 3] {
         let d = delta.x.hypot(delta.y);
         let a = delta.theta.abs();
         let s = self.base_std;
-        OdometryPrior::from_std(
-            predicted,
-            [
-                s[0] + self.per_metre * d,
-                s[1] + self.per_metre * d,
-                s[2] + self.per_metre * d + self.per_radian * a,
-            ],
-        )
+        [
+            s[0] + self.per_metre * d,
+            s[1] + self.per_metre * d,
+            s[2] + self.per_metre * d + self.per_radian * a,
+        ]
     }
 }
 
@@ -139,42 +141,76 @@ impl ScanToMapSlam {
             None => Pose2::default(),
         };
         self.last_odom = Some(*odom);
-        let predicted = self.pose.compose(&delta);
-        let mut covariance = [[0.0; 3]; 3];
-        self.pose = predicted;
         let points = base_points(scan, mount, self.config.beam_stride);
-        let prior = self.config.prior.map(|m| m.prior(predicted, &delta));
-        if points.len() >= 3
-            && let Some(r) = self
-                .map
-                .match_points(&points, predicted, prior, &self.config.matcher)
-        {
+        let t = track(&self.map, &self.config, self.pose, &delta, &points);
+        if let Some(converged) = t.converged {
             self.matches += 1;
-            if !r.converged {
+            if !converged {
                 self.unconverged += 1;
             }
-            if r.pose.x.is_finite() && r.pose.y.is_finite() && r.pose.theta.is_finite() {
-                self.pose = r.pose;
-                covariance = r.covariance;
-            }
         }
-        let due = match self.last_insert {
-            None => true,
-            Some(p) => {
-                p.distance(&self.pose) >= self.config.map_update_min_d
-                    || wrap_angle(p.theta - self.pose.theta).abs() >= self.config.map_update_min_a
-            }
-        };
-        if due {
+        self.pose = t.pose;
+        if insertion_due(self.last_insert, &self.pose, &self.config) {
             self.map.insert(&self.pose.compose(mount), scan);
             self.last_insert = Some(self.pose);
         }
         self.estimate = Some(PoseEstimate {
             pose: self.pose,
-            covariance,
+            covariance: t.covariance,
             weight: 1.0,
         });
         self.path.push((scan.stamp, self.pose));
+    }
+}
+
+/// The outcome of [`track`].
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Tracked {
+    pub pose: Pose2,
+    pub covariance: [[f64; 3]; 3],
+    /// None when no match ran (empty map or too few points), else whether it converged.
+    pub converged: Option<bool>,
+}
+
+/// The local tracking step scan-to-map and graph SLAM share: predict `pose` by the odometry
+/// motion `delta`, then refine it by Gauss-Newton against `map` (with the odometry prior of
+/// `config`); a non-finite result keeps the prediction.
+pub(super) fn track(
+    map: &MatchedMap,
+    config: &ScanToMapConfig,
+    pose: Pose2,
+    delta: &Pose2,
+    points: &[[f32; 2]],
+) -> Tracked {
+    let predicted = pose.compose(delta);
+    let mut out = Tracked {
+        pose: predicted,
+        covariance: [[0.0; 3]; 3],
+        converged: None,
+    };
+    if points.len() < 3 {
+        return out;
+    }
+    let prior = config.prior.map(|m| m.prior(predicted, delta));
+    if let Some(r) = map.match_points(points, predicted, prior, &config.matcher) {
+        out.converged = Some(r.converged);
+        if r.pose.x.is_finite() && r.pose.y.is_finite() && r.pose.theta.is_finite() {
+            out.pose = r.pose;
+            out.covariance = r.covariance;
+        }
+    }
+    out
+}
+
+/// Whether the robot at `pose` moved far enough from `last` (the pose of the last insertion) for
+/// a new one (always true for the first).
+pub(super) fn insertion_due(last: Option<Pose2>, pose: &Pose2, config: &ScanToMapConfig) -> bool {
+    match last {
+        None => true,
+        Some(p) => {
+            p.distance(pose) >= config.map_update_min_d
+                || wrap_angle(p.theta - pose.theta).abs() >= config.map_update_min_a
+        }
     }
 }
 

@@ -11,8 +11,11 @@ fn hospital_loop_with(slam: &str) -> String {
 }
 
 #[test]
-fn scan_to_map_slam_tracks_two_laps_of_the_hospital_while_odometry_drifts() {
-    let text = hospital_loop_with("[[robots.slam]]\ntype = \"scan_to_map\"");
+fn scan_to_map_and_graph_slam_track_two_laps_of_the_hospital_while_odometry_drifts() {
+    let text = hospital_loop_with(
+        "[[robots.slam]]\ntype = \"scan_to_map\"\n\
+         [[robots.slam]]\ntype = \"graph\"\nresolution = 0.04",
+    );
     let out = run_scenario(&scenario(&text), &RunOptions::default()).expect("runs");
     let r = &out.summary.robots[0];
     assert!(
@@ -25,6 +28,17 @@ fn scan_to_map_slam_tracks_two_laps_of_the_hospital_while_odometry_drifts() {
     let ate = s.ate_rmse_m.unwrap();
     assert!(ate < 0.1, "scan-to-map ATE {ate} m");
     assert!(s.final_error_m.unwrap() < 0.15, "{s:?}");
+    // graph SLAM: online poses, and the optimized trajectory after the last optimization
+    let g = &r.localization["graph"];
+    assert!(g.estimates > 2000, "one estimate per scan: {g:?}");
+    let online = g.ate_rmse_m.unwrap();
+    assert!(online < 0.1, "graph SLAM online ATE {online} m");
+    let f = g
+        .final_trajectory
+        .expect("a SLAM system reports its final trajectory");
+    assert_eq!(f.poses, g.estimates, "one optimized pose per scan");
+    let ate = f.ate_rmse_m.unwrap();
+    assert!(ate < 0.05, "graph SLAM ATE after optimization {ate} m");
 }
 
 #[test]

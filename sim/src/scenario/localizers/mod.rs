@@ -353,6 +353,8 @@ pub enum LocalizerKind {
     DeOdometry(DeOdometryConfig),
     /// Scan-to-map SLAM (from the robot's `slam` key).
     ScanToMap(Box<systems::mapping::ScanToMapConfig>),
+    /// Graph SLAM (from the robot's `slam` key).
+    Graph(Box<systems::mapping::GraphSlamConfig>),
 }
 
 impl LocalizerConfig {
@@ -364,7 +366,8 @@ impl LocalizerConfig {
             LocalizerKind::DeFilter(_)
             | LocalizerKind::DeMc(_)
             | LocalizerKind::DeOdometry(_)
-            | LocalizerKind::ScanToMap(_) => None,
+            | LocalizerKind::ScanToMap(_)
+            | LocalizerKind::Graph(_) => None,
         }
     }
 }
