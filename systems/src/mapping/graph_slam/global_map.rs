@@ -1,10 +1,15 @@
 //! The graph SLAM's map: every node's scan inserted at its optimized pose (Cartographer rebuilds
 //! its map from the optimized submap poses; we go one step finer and re-insert the scans, so the
-//! map is exactly what known-pose mapping ([`crate::mapping::occupancy`]) makes of the optimized
-//! trajectory). Rebuilt from scratch when an optimization moved the nodes, extended with the new
-//! nodes otherwise.
+//! map is what known-pose mapping ([`crate::mapping::occupancy`]) makes of the optimized
+//! trajectory).
+//!
+//! Kept up to date lazily: new nodes are appended; the whole map is rebuilt only when an
+//! optimization moved some already inserted laser pose by more than half a cell at its
+//! farthest reading (translation plus rotation × `reach`). Most optimizations move old nodes by
+//! millimetres, so a recording that asks for the map every few seconds no longer pays a full
+//! rebuild after each of them.
 
-use crate::core::Pose2;
+use crate::core::{Pose2, wrap_angle};
 use crate::mapping::occupancy::{LogOddsMap, OccupancyParams};
 use crate::matching::ProbGrid;
 use crate::sensors::LaserScan;
@@ -12,8 +17,8 @@ use std::sync::Mutex;
 
 #[derive(Debug)]
 struct Cache {
-    version: u64,
-    inserted: usize,
+    /// The laser poses the map holds, in node order.
+    poses: Vec<Pose2>,
     map: LogOddsMap,
 }
 
@@ -40,29 +45,34 @@ impl CachedMap {
         }
     }
 
-    /// The map of `scans` (laser pose, scan) as of graph `version`.
-    pub fn get<'a>(
-        &self,
-        version: u64,
-        scans: impl Iterator<Item = (Pose2, &'a LaserScan)>,
-    ) -> ProbGrid {
+    /// The map of `scans` (laser pose, scan), in node order.
+    pub fn get<'a>(&self, scans: impl Iterator<Item = (Pose2, &'a LaserScan)>) -> ProbGrid {
+        let scans: Vec<(Pose2, &LaserScan)> = scans.collect();
         let mut guard = match self.cache.lock() {
             Ok(g) => g,
             Err(poisoned) => poisoned.into_inner(),
         };
-        if guard.as_ref().is_none_or(|c| c.version != version) {
+        let tolerance = 0.5 * self.resolution;
+        let reach = f64::from(self.params.max_range);
+        let stale = guard.as_ref().is_none_or(|c| {
+            c.poses.len() > scans.len()
+                || c.poses.iter().zip(&scans).any(|(old, (new, scan))| {
+                    let reach = reach.min(f64::from(scan.range_max));
+                    old.distance(new) + wrap_angle(old.theta - new.theta).abs() * reach > tolerance
+                })
+        });
+        if stale {
             *guard = Some(Cache {
-                version,
-                inserted: 0,
+                poses: Vec::new(),
                 map: LogOddsMap::new(self.resolution, self.params.clone()),
             });
         }
         let Some(cache) = guard.as_mut() else {
             return ProbGrid::new(0, 0, self.resolution, [0.0, 0.0], 0.5);
         };
-        for (sensor, scan) in scans.skip(cache.inserted) {
-            cache.map.insert_scan(&sensor, scan);
-            cache.inserted += 1;
+        for (sensor, scan) in scans.iter().skip(cache.poses.len()) {
+            cache.map.insert_scan(sensor, scan);
+            cache.poses.push(*sensor);
         }
         cache.map.to_prob_grid()
     }

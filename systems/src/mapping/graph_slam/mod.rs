@@ -118,8 +118,6 @@ pub struct GraphSlam {
     nodes_since_optimization: usize,
     constraints_since_optimization: usize,
     pub stats: GraphStats,
-    /// Bumped whenever optimization moves nodes (the map cache's key).
-    version: u64,
     map_cache: CachedMap,
 }
 
@@ -148,7 +146,6 @@ impl GraphSlam {
             nodes_since_optimization: 0,
             constraints_since_optimization: 0,
             stats: GraphStats::default(),
-            version: 0,
             map_cache,
             config,
         }
@@ -315,7 +312,6 @@ impl GraphSlam {
         }
         self.nodes_since_optimization = 0;
         self.constraints_since_optimization = 0;
-        self.version += 1;
     }
 
     /// Runs the last optimization with the constraints found since the previous one
@@ -366,7 +362,7 @@ impl ScanEstimator for GraphSlam {
             .iter()
             .zip(&self.graph.nodes)
             .map(|(n, g)| (g.compose(&n.mount), &n.scan));
-        Some(self.map_cache.get(self.version, scans))
+        Some(self.map_cache.get(scans))
     }
 
     fn trajectory(&self) -> Vec<(f64, Pose2)> {
