@@ -19,7 +19,7 @@ use systems::localization::{
     Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
     NavSource, OdometryModel, ScanEstimator, WheelOdometry,
 };
-use systems::mapping::{GraphSlam, MappingPlugin, ScanToMapSlam};
+use systems::mapping::{GraphSlam, MappingPlugin, RbpfSlam, ScanToMapSlam};
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
@@ -288,6 +288,7 @@ pub fn new_filter(
         }
         LocalizerKind::ScanToMap(c) => Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()))),
         LocalizerKind::Graph(c) => Filter::Scan(Box::new(GraphSlam::new((**c).clone()))),
+        LocalizerKind::Rbpf(c) => Filter::Scan(Box::new(RbpfSlam::new((**c).clone(), rng))),
     })
 }
 

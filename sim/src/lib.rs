@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod bench_loc;
 pub mod bench_match;
+pub mod bench_slam;
 pub mod build;
 pub mod carmen;
 pub mod carmen_out;

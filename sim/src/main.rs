@@ -4,7 +4,12 @@ use clap::{Parser, Subcommand};
 use sim::bench::{SwarmOptions, run_swarm_bench};
 use sim::bench_loc::{LocBenchOptions, run_markov_grid_bench, run_mcl_bench};
 use sim::bench_match::{DeMatchBenchOptions, run_de_match_bench};
+use sim::bench_slam::{SlamBenchOptions, run_slam_bench};
 use sim::experiment::de_match::{DeMatchOptions, run_de_match_experiment};
+use sim::experiment::slam_compare::{
+    METHODS as SLAM_METHODS, SCENARIOS as SLAM_SCENARIOS, SlamExperimentOptions,
+    run_slam_experiment, table as slam_table,
+};
 use sim::match_cmd::{CrossoverArg, FitnessArg, MatchOptions, parse_strategy, run_match};
 use sim::run_cmd::{RunArgs, check_duration, run_command, scenario_arg};
 use sim::runner::ScanCapture;
@@ -143,6 +148,21 @@ enum BenchCommand {
         #[arg(long, default_value_t = 0)]
         threads: usize,
     },
+    /// Real-time factor and time per scan of each SLAM mode on the hospital loop run.
+    Slam {
+        /// One JSON object per mode, one per line.
+        #[arg(long)]
+        json: bool,
+        /// SLAM modes to time.
+        #[arg(long, value_delimiter = ',', default_values_t = ["scan_to_map", "graph", "rbpf"].map(String::from))]
+        modes: Vec<String>,
+        /// Kernel threads the SLAM runs on (the targets are for one core).
+        #[arg(long, default_value_t = 1)]
+        threads: usize,
+        /// Simulate only this many seconds of the scenario (quick checks).
+        #[arg(long)]
+        duration: Option<f64>,
+    },
     /// DE scan-matching time per alignment of 1081-beam hospital scans (one core).
     DeMatch {
         /// One JSON object per method, one per line.
@@ -217,6 +237,23 @@ enum ExperimentCommand {
         /// Print every wrong alignment (scan indices, truth, answer) to stderr.
         #[arg(long)]
         list_wrong: bool,
+    },
+    /// The maze run of 000_9f0113837c153763.txt and the hospital loop: ATE, RPE and map quality
+    /// of wheel odometry, DE scan-to-scan odometry, scan-to-map, RBPF and graph SLAM on
+    /// identical data.
+    MazeSlam {
+        /// One JSON object per scenario and method, one per line.
+        #[arg(long)]
+        json: bool,
+        /// Scenarios: bundled names or paths.
+        #[arg(long, value_delimiter = ',', default_values_t = SLAM_SCENARIOS.map(String::from))]
+        scenarios: Vec<String>,
+        /// Methods to run.
+        #[arg(long, value_delimiter = ',', default_values_t = SLAM_METHODS.map(String::from))]
+        methods: Vec<String>,
+        /// Kernel threads (0 = one per core). Results do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
     },
 }
 
@@ -348,6 +385,27 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
                 only,
                 list_wrong,
             }),
+            ExperimentCommand::MazeSlam {
+                json,
+                scenarios,
+                methods,
+                threads,
+            } => {
+                let rows = run_slam_experiment(&SlamExperimentOptions {
+                    scenarios,
+                    methods,
+                    threads,
+                    progress: !json,
+                })?;
+                if json {
+                    for r in &rows {
+                        println!("{}", serde_json::to_string(r)?);
+                    }
+                } else {
+                    print!("{}", slam_table(&rows));
+                }
+                Ok(())
+            }
         },
         Command::Bench { which } => match which {
             BenchCommand::Swarm {
@@ -382,6 +440,18 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
                     beams,
                 })
             }
+            BenchCommand::Slam {
+                json,
+                modes,
+                threads,
+                duration,
+            } => run_slam_bench(&SlamBenchOptions {
+                json,
+                modes,
+                threads,
+                duration,
+            })
+            .map(|_| ()),
             BenchCommand::DeMatch { json, pairs } => {
                 run_de_match_bench(&DeMatchBenchOptions { json, pairs })
             }

@@ -371,6 +371,7 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                     person_collisions: m.collisions.person,
                     odometry_drift_m: m.odometry_drift_m,
                     max_odometry_drift_m: m.max_odometry_drift_m,
+                    odometry_ate_m: m.odometry_ate_m(),
                     odometry_drift_percent: if m.distance_m > 0.0 {
                         100.0 * m.odometry_drift_m / m.distance_m
                     } else {

@@ -27,6 +27,8 @@ pub struct RobotSummary {
     /// Final wheel-odometry position error (m).
     pub odometry_drift_m: f64,
     pub max_odometry_drift_m: f64,
+    /// RMSE of the wheel odometry's position error over the run (its ATE, m).
+    pub odometry_ate_m: f64,
     /// Final drift per distance driven (%).
     pub odometry_drift_percent: f64,
     pub odometry_heading_error_rad: f64,

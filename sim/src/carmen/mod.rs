@@ -327,6 +327,17 @@ impl CarmenEvent<'_> {
 }
 
 impl CarmenLog {
+    /// The front scans in time order (as [`CarmenLog::events`] yields them): what a SLAM system
+    /// is fed.
+    pub fn front_scans(&self) -> Vec<&ScanRecord> {
+        self.events()
+            .filter_map(|e| match e {
+                CarmenEvent::Scan(s) => Some(s),
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Every record merged by timestamp. Ties keep the order odometry, truth, front scan, rear
     /// scan (so a scan sees the odometry of its own instant), then the order within each list.
     pub fn events(&self) -> impl Iterator<Item = CarmenEvent<'_>> + '_ {

@@ -7,12 +7,13 @@ use super::localizers::{LocalizerConfig, LocalizerKind};
 use super::resolve::{Checker, R};
 use serde::Deserialize;
 use systems::core::Pose2;
+use systems::mapping::rbpf::proposal::SampleGrid;
 use systems::mapping::scan_to_map::OdometryPriorModel;
-use systems::mapping::{GraphSlamConfig, ScanToMapConfig};
+use systems::mapping::{GraphSlamConfig, RbpfConfig, ScanToMapConfig};
 
 #[derive(Debug)]
 pub enum SlamList {
-    One(SlamFile),
+    One(Box<SlamFile>),
     Many(Vec<SlamFile>),
 }
 
@@ -32,7 +33,7 @@ impl<'de> Deserialize<'de> for SlamList {
                 .collect::<Result<Vec<_>, _>>()
                 .map(SlamList::Many),
             v @ toml::Value::Table(_) => SlamFile::deserialize(v)
-                .map(SlamList::One)
+                .map(|f| SlamList::One(Box::new(f)))
                 .map_err(|e| D::Error::custom(e.to_string())),
             other => Err(D::Error::custom(format!(
                 "expected a table `{{ type = \"scan_to_map\", … }}` or `[[robots.slam]]` tables, got {}",
@@ -45,7 +46,7 @@ impl<'de> Deserialize<'de> for SlamList {
 impl SlamList {
     pub fn items(&self) -> &[SlamFile] {
         match self {
-            SlamList::One(s) => std::slice::from_ref(s),
+            SlamList::One(s) => std::slice::from_ref(s.as_ref()),
             SlamList::Many(v) => v,
         }
     }
@@ -56,6 +57,7 @@ impl SlamList {
 pub enum SlamType {
     ScanToMap,
     Graph,
+    Rbpf,
 }
 
 impl SlamType {
@@ -63,6 +65,7 @@ impl SlamType {
         match self {
             SlamType::ScanToMap => "scan_to_map",
             SlamType::Graph => "graph",
+            SlamType::Rbpf => "rbpf",
         }
     }
 }
@@ -89,6 +92,47 @@ pub struct SlamFile {
     pub p_miss: Option<f64>,
     /// How far a beam without a return clears free space (m).
     pub clear_range: Option<f64>,
+    /// RBPF only, under GMapping's names (001_6ab7973871dfdca6.txt): number of particles, the
+    /// motion that triggers an update (m, rad), the proposal's sampling grid (m, rad).
+    pub particles: Option<usize>,
+    #[serde(rename = "linearUpdate")]
+    pub linear_update: Option<f64>,
+    #[serde(rename = "angularUpdate")]
+    pub angular_update: Option<f64>,
+    pub llsamplerange: Option<f64>,
+    pub llsamplestep: Option<f64>,
+    pub lasamplerange: Option<f64>,
+    pub lasamplestep: Option<f64>,
+}
+
+impl SlamFile {
+    /// The keys given that `kind` does not use.
+    fn foreign_keys(&self) -> Vec<&'static str> {
+        let rbpf_keys = [
+            ("particles", self.particles.is_some()),
+            ("linearUpdate", self.linear_update.is_some()),
+            ("angularUpdate", self.angular_update.is_some()),
+            ("llsamplerange", self.llsamplerange.is_some()),
+            ("llsamplestep", self.llsamplestep.is_some()),
+            ("lasamplerange", self.lasamplerange.is_some()),
+            ("lasamplestep", self.lasamplestep.is_some()),
+        ];
+        let matcher_keys = [
+            ("levels", self.levels.is_some()),
+            ("map_update_min_d", self.map_update_min_d.is_some()),
+            ("map_update_min_a", self.map_update_min_a.is_some()),
+            ("odometry_prior", self.odometry_prior.is_some()),
+        ];
+        let foreign: &[(&'static str, bool)] = match self.kind {
+            SlamType::Rbpf => &matcher_keys,
+            SlamType::ScanToMap | SlamType::Graph => &rbpf_keys,
+        };
+        foreign
+            .iter()
+            .filter(|(_, given)| *given)
+            .map(|(k, _)| *k)
+            .collect()
+    }
 }
 
 /// Validates the robot's SLAM systems; they start at the robot's start pose.
@@ -121,6 +165,16 @@ pub(super) fn resolve_slam(
             return c.err(
                 &sp.key(key),
                 format!("`{name}` is already the name of a localizer or SLAM system of this robot: give each a `name`"),
+            );
+        }
+        if let Some(k) = s.foreign_keys().first() {
+            let users = match s.kind {
+                SlamType::Rbpf => "`scan_to_map` and `graph`",
+                _ => "`rbpf`",
+            };
+            return c.err(
+                &sp.key(k),
+                format!("`{k}` applies to {users}, not to `{}`", s.kind.name()),
             );
         }
         let d = ScanToMapConfig::default();
@@ -182,6 +236,7 @@ pub(super) fn resolve_slam(
             init_pose: *start,
         };
         let kind = match s.kind {
+            SlamType::Rbpf => LocalizerKind::Rbpf(Box::new(rbpf_config(c, &sp, s, config)?)),
             SlamType::ScanToMap => LocalizerKind::ScanToMap(Box::new(config)),
             SlamType::Graph => LocalizerKind::Graph(Box::new(GraphSlamConfig {
                 local: config,
@@ -191,4 +246,47 @@ pub(super) fn resolve_slam(
         out.push(LocalizerConfig { name, kind });
     }
     Ok(out)
+}
+
+/// The RBPF's configuration: GMapping's parameters from the file, the map's (resolution,
+/// occupancy model, beam stride, start pose) from the shared keys.
+fn rbpf_config(c: &Checker, sp: &KeyPath, s: &SlamFile, shared: ScanToMapConfig) -> R<RbpfConfig> {
+    let d = RbpfConfig::default();
+    let particles = match s.particles {
+        Some(n) if !(1..=10_000).contains(&n) => {
+            return c.err(
+                &sp.key("particles"),
+                format!("expected 1 to 10000, got {n}"),
+            );
+        }
+        Some(n) => n,
+        None => d.particles,
+    };
+    let sample = |key: &str, v: Option<f64>, default: f64| -> R<f64> {
+        match v {
+            Some(v) => c.range(&sp.key(key), v, Some(0.0), Some(1.0), false),
+            None => Ok(default),
+        }
+    };
+    let g = d.sample;
+    Ok(RbpfConfig {
+        particles,
+        linear_update: c.opt_positive(&sp.key("linearUpdate"), s.linear_update, d.linear_update)?,
+        angular_update: c.opt_positive(
+            &sp.key("angularUpdate"),
+            s.angular_update,
+            d.angular_update,
+        )?,
+        sample: SampleGrid {
+            llsamplerange: sample("llsamplerange", s.llsamplerange, g.llsamplerange)?,
+            llsamplestep: sample("llsamplestep", s.llsamplestep, g.llsamplestep)?,
+            lasamplerange: sample("lasamplerange", s.lasamplerange, g.lasamplerange)?,
+            lasamplestep: sample("lasamplestep", s.lasamplestep, g.lasamplestep)?,
+        },
+        resolution: shared.resolution,
+        occupancy: shared.occupancy,
+        beam_stride: s.beam_stride.unwrap_or(d.beam_stride),
+        init_pose: shared.init_pose,
+        ..d
+    })
 }

@@ -165,4 +165,51 @@ mod tests {
             .to_string();
         assert!(e.starts_with("s.toml:"), "{e}");
     }
+
+    #[test]
+    fn rbpf_takes_gmappings_parameter_names_and_rejects_the_matchers() {
+        let file = "particles = 15\nlinearUpdate = 0.5\nangularUpdate = 0.25\n\
+                    llsamplerange = 0.02\nlasamplestep = 0.01\nresolution = 0.04\n";
+        let c = resolve_slam_config(Some("rbpf"), Some(("g.toml", file)), &start()).unwrap();
+        let LocalizerKind::Rbpf(r) = &c.kind else {
+            panic!("{c:?}")
+        };
+        assert_eq!((c.name.as_str(), r.particles), ("rbpf", 15));
+        assert_eq!((r.linear_update, r.angular_update), (0.5, 0.25));
+        assert_eq!(
+            (r.sample.llsamplerange, r.sample.lasamplestep),
+            (0.02, 0.01)
+        );
+        // the ones not given keep the seed's values
+        assert_eq!(
+            (r.sample.llsamplestep, r.sample.lasamplerange),
+            (0.01, 0.005)
+        );
+        assert_eq!((r.resolution, r.init_pose), (0.04, start()));
+        let err = |t: &str, f: &str| {
+            resolve_slam_config(Some(t), Some(("g.toml", f)), &start())
+                .unwrap_err()
+                .to_string()
+        };
+        let e = err("rbpf", "\nparticles = 0\n");
+        assert!(e.starts_with("g.toml:2:") && e.contains("particles"), "{e}");
+        let e = err("rbpf", "linearUpdate = -1\n");
+        assert!(
+            e.starts_with("g.toml:1:") && e.contains("linearUpdate"),
+            "{e}"
+        );
+        let e = err("rbpf", "llsamplestep = 2\n");
+        assert!(e.contains("llsamplestep"), "{e}");
+        let e = err("rbpf", "levels = 2\n");
+        assert!(
+            e.starts_with("g.toml:1:")
+                && e.contains("`levels` applies to `scan_to_map` and `graph`"),
+            "{e}"
+        );
+        let e = err("graph", "\nparticles = 30\n");
+        assert!(
+            e.starts_with("g.toml:2:") && e.contains("`particles` applies to `rbpf`"),
+            "{e}"
+        );
+    }
 }

@@ -14,19 +14,20 @@
 //! trajectory and the raw odometry are judged against them ([`eval`]).
 
 pub mod eval;
+pub mod feed;
 pub mod report;
 
 use crate::build::new_scan_estimator;
-use crate::carmen::{CarmenEvent, CarmenReadOptions, OldLaserOverrides, ScanRecord, read_carmen};
+use crate::carmen::{CarmenReadOptions, OldLaserOverrides, read_carmen};
 use crate::map_out::{MapToSave, save_maps};
 use crate::record::replay::ReplayRecorder;
 use crate::record::tum::tum_line;
 use crate::scenario::slam_file::resolve_slam_config;
 use eval::TruthTrack;
+use feed::feed_scans;
 use indicatif::{ProgressBar, ProgressStyle};
 use report::{MapInfo, SlamReport};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 use systems::core::{KernelPool, Pose2, stream_rng};
 
 #[derive(clap::Args, Clone, Debug)]
@@ -149,13 +150,7 @@ fn write_tum(path: &Path, poses: impl Iterator<Item = (f64, Pose2)>) -> anyhow::
 pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     let log = read_carmen(&a.carmen, &read_options(a)?)?;
     let file = a.carmen.display().to_string();
-    let scans: Vec<&ScanRecord> = log
-        .events()
-        .filter_map(|e| match e {
-            CarmenEvent::Scan(s) => Some(s),
-            _ => None,
-        })
-        .collect();
+    let scans = log.front_scans();
     let Some(first) = scans.first() else {
         anyhow::bail!("{file}: no front laser scans (FLASER or ROBOTLASER1 lines): nothing to map");
     };
@@ -204,31 +199,21 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
         );
     }
     let bar = progress(a.quiet, scans.len());
-    let started = Instant::now();
-    let mut online: Vec<(f64, Pose2)> = Vec::with_capacity(scans.len());
-    for (k, s) in scans.iter().enumerate() {
-        let scan = s.to_laser_scan();
-        if pool.install(|| est.update(&scan, &s.mount, &s.robot_pose))
-            && let Some(e) = est.estimate()
-        {
-            online.push((s.timestamp, e.pose));
-        }
+    let run = feed_scans(est.as_mut(), &scans, &pool, |k, s, scan, est| {
         if let Some(r) = rec.as_mut() {
             let at = (s.timestamp, &s.robot_pose, truth.at(s.timestamp), &s.mount);
-            r.scan(est.as_ref(), &scan, at);
+            r.scan(est, scan, at);
         }
         if k % 50 == 0 {
             bar.set_position(k as u64 + 1);
         }
-    }
-    // a smoother's final optimization is part of the run
-    pool.install(|| est.finish());
+    });
     bar.finish_and_clear();
-    let wall_time_s = started.elapsed().as_secs_f64();
+    let wall_time_s = run.wall_time_s;
     if let Some(r) = rec {
         r.finish(est.as_ref(), t1)?;
     }
-    let trajectory = est.trajectory();
+    let (online, trajectory) = (run.online, run.trajectory);
     let odometry: Vec<(f64, Pose2)> = scans.iter().map(|s| (s.timestamp, s.robot_pose)).collect();
     let map = est.map();
     let mut report = SlamReport {

@@ -14,6 +14,9 @@ pub struct RobotMetrics {
     /// Current odometry position error (m).
     pub odometry_drift_m: f64,
     pub max_odometry_drift_m: f64,
+    /// Σ of the squared odometry position error over the ticks, and the ticks counted.
+    pub odometry_sq_sum: f64,
+    pub odometry_samples: u64,
     /// Current odometry heading error (rad).
     pub odometry_heading_error_rad: f64,
 }
@@ -34,7 +37,20 @@ pub fn accumulate_metrics(
         if let Some(o) = odom {
             m.odometry_drift_m = o.pose.distance(&truth.pose);
             m.max_odometry_drift_m = m.max_odometry_drift_m.max(m.odometry_drift_m);
+            m.odometry_sq_sum += m.odometry_drift_m * m.odometry_drift_m;
+            m.odometry_samples += 1;
             m.odometry_heading_error_rad = wrap_angle(o.pose.theta - truth.pose.theta).abs();
         }
+    }
+}
+
+impl RobotMetrics {
+    /// The absolute trajectory error of wheel odometry alone: RMSE of its position error over
+    /// every tick (m); 0 without odometry.
+    pub fn odometry_ate_m(&self) -> f64 {
+        if self.odometry_samples == 0 {
+            return 0.0;
+        }
+        (self.odometry_sq_sum / self.odometry_samples as f64).sqrt()
     }
 }

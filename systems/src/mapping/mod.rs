@@ -12,17 +12,22 @@
 //! * [`scan_to_map`] — scan-to-map SLAM (Hector-style Gauss-Newton with an odometry prior);
 //! * [`graph_slam`] — graph SLAM: submaps, branch-and-bound loop closure, pose-graph optimization
 //!   (Cartographer-style);
+//! * [`rbpf`] — Rao-Blackwellized particle filter SLAM (GMapping-style: a map per particle,
+//!   improved proposal from scan matching, adaptive resampling);
 //! * [`pose_graph`] — sparse pose adjustment on SE(2) with a Huber kernel, the back end of
 //!   graph-based SLAM;
+//! * `insert` — applying one scan's hits and misses to log-odds cells (private);
 //! * `grow` — a grid's extent on a fixed cell lattice and growth by whole blocks (private).
 
 pub mod align;
 pub mod graph_slam;
 mod grow;
+mod insert;
 pub mod matched_map;
 pub mod occupancy;
 pub mod pose_graph;
 pub mod quality;
+pub mod rbpf;
 pub mod scan_to_map;
 
 #[cfg(test)]
@@ -33,6 +38,7 @@ pub use occupancy::{InsertStats, LogOddsMap, OccupancyParams};
 pub use quality::{MapQuality, map_quality, quality_with_start_pose};
 
 pub use graph_slam::{GraphSlam, GraphSlamConfig};
+pub use rbpf::{RbpfConfig, RbpfSlam};
 pub use scan_to_map::{ScanToMapConfig, ScanToMapSlam};
 
 use crate::core::{KernelPool, SimPlugin, SimSet};

@@ -28,9 +28,11 @@
 //! (measured on a shared 2-core machine under load, so an upper bound).
 
 use super::grow::{Extent, grow_to};
+use super::insert::{
+    Beam, CellStore, GridFrame, LogOddsModel, apply_beams, beam_box, prepare_beams,
+};
 use crate::core::Pose2;
 use crate::matching::ProbGrid;
-use crate::raycast::traverse_segment;
 use crate::sensors::LaserScan;
 use crate::world::OccupancyGrid;
 
@@ -123,11 +125,7 @@ pub struct InsertStats {
 #[derive(Clone, Debug)]
 pub struct LogOddsMap {
     params: OccupancyParams,
-    /// log-odds of the parameters.
-    l_hit: f32,
-    l_miss: f32,
-    l_min: f32,
-    l_max: f32,
+    model: LogOddsModel,
     grows: bool,
     extent: Extent,
     /// log-odds per cell, `row * width + col`.
@@ -135,8 +133,8 @@ pub struct LogOddsMap {
     /// The scan that last updated each cell (one update per cell per scan).
     stamps: Vec<u32>,
     scan_id: u32,
-    /// Per-scan scratch: each used beam's direction, length and whether it is a return.
-    beams: Vec<([f32; 2], f32, bool)>,
+    /// Per-scan scratch: the beams used.
+    beams: Vec<Beam>,
 }
 
 impl LogOddsMap {
@@ -164,10 +162,7 @@ impl LogOddsMap {
         assert!(extent.resolution > 0.0, "resolution must be positive");
         let n = extent.width * extent.height;
         LogOddsMap {
-            l_hit: log_odds(params.p_hit),
-            l_miss: log_odds(params.p_miss),
-            l_min: log_odds(params.p_min),
-            l_max: log_odds(params.p_max),
+            model: LogOddsModel::new(&params),
             params,
             grows,
             extent,
@@ -240,69 +235,33 @@ impl LogOddsMap {
         if !(sensor.x.is_finite() && sensor.y.is_finite() && sensor.theta.is_finite()) {
             return stats;
         }
-        let max_range = limits[1].min(self.params.max_range);
-        let clear = self.params.clear_range.min(max_range).max(0.0);
         let mut beams = std::mem::take(&mut self.beams);
-        beams.clear();
-        for (k, &r) in ranges.iter().enumerate() {
-            let (len, hit) = if r.is_nan() || r < limits[0] {
-                stats.ignored += 1; // NaN, −Inf and too-close readings
-                continue;
-            } else if r <= max_range {
-                (r, true)
-            } else if clear > 0.0 {
-                (clear, false)
-            } else {
-                continue;
-            };
-            // the angle in f64: k · increment summed in f32 loses ~1e-7 rad at k = 1080
-            let a = sensor.theta + angle_min as f64 + k as f64 * angle_increment as f64;
-            let (s, c) = a.sin_cos();
-            beams.push(([c as f32, s as f32], len, hit));
-        }
+        prepare_beams(
+            &self.params,
+            sensor,
+            [angle_min, angle_increment],
+            limits,
+            ranges,
+            &mut beams,
+            &mut stats,
+        );
         let (lo, hi) = beam_box([sensor.x, sensor.y], &beams);
         if self.grows {
             self.grow_to_hold(lo, hi);
         }
         stats.window = self.window(lo, hi);
         self.next_scan();
-        let (w, h) = (self.width(), self.height());
-        let res = self.extent.resolution;
-        let o = self.extent.origin();
-        // grid-relative sensor position, in f64 before the f32 kernel
-        let p = [(sensor.x - o[0]) as f32, (sensor.y - o[1]) as f32];
-        let (pd, resf) = ([sensor.x - o[0], sensor.y - o[1]], res as f32);
-        let id = self.scan_id;
-        let (cells, stamps) = (&mut self.cells, &mut self.stamps);
-        // hits first: they win over misses of other beams in the same scan
-        for &(d, len, hit) in &beams {
-            if !hit {
-                stats.clears += 1;
-                continue;
-            }
-            let ex = ((pd[0] + d[0] as f64 * len as f64) / res).floor();
-            let ey = ((pd[1] + d[1] as f64 * len as f64) / res).floor();
-            if ex < 0.0 || ey < 0.0 || ex >= w as f64 || ey >= h as f64 {
-                continue;
-            }
-            stats.hits += 1;
-            let i = ey as usize * w + ex as usize;
-            if stamps[i] != id {
-                stamps[i] = id;
-                cells[i] = (cells[i] + self.l_hit).min(self.l_max);
-            }
-        }
-        let (l_miss, l_min) = (self.l_miss, self.l_min);
-        let short = self.params.hit_clear_gap * resf;
-        for &(d, len, hit) in &beams {
-            let len = if hit { (len - short).max(0.0) } else { len };
-            traverse_segment(w, h, resf, [0.0, 0.0], p, d, len, |i| {
-                if stamps[i] != id {
-                    stamps[i] = id;
-                    cells[i] = (cells[i] + l_miss).max(l_min);
-                }
-            });
-        }
+        let grid = GridFrame {
+            width: self.width(),
+            height: self.height(),
+            resolution: self.extent.resolution,
+            origin: self.extent.origin(),
+        };
+        let mut store = FlatCells {
+            cells: &mut self.cells,
+            stamps: &mut self.stamps,
+        };
+        stats.hits = apply_beams(&mut store, &grid, sensor, &beams, &self.model, self.scan_id);
         self.beams = beams;
         stats
     }
@@ -366,13 +325,18 @@ impl LogOddsMap {
 #[path = "occupancy_tests.rs"]
 mod tests;
 
-/// The bounding box of the sensor at `p` and every beam's end point.
-fn beam_box(p: [f64; 2], beams: &[([f32; 2], f32, bool)]) -> ([f64; 2], [f64; 2]) {
-    let (mut lo, mut hi) = (p, p);
-    for &(d, len, _) in beams {
-        let e = [p[0] + (d[0] * len) as f64, p[1] + (d[1] * len) as f64];
-        lo = [lo[0].min(e[0]), lo[1].min(e[1])];
-        hi = [hi[0].max(e[0]), hi[1].max(e[1])];
+/// [`LogOddsMap`]'s cells as a [`CellStore`].
+struct FlatCells<'a> {
+    cells: &'a mut [f32],
+    stamps: &'a mut [u32],
+}
+
+impl CellStore for FlatCells<'_> {
+    #[inline]
+    fn update_once(&mut self, i: usize, id: u32, delta: f32, lo: f32, hi: f32) {
+        if self.stamps[i] != id {
+            self.stamps[i] = id;
+            self.cells[i] = (self.cells[i] + delta).max(lo).min(hi);
+        }
     }
-    (lo, hi)
 }

@@ -236,7 +236,7 @@ fn damped(h: &[f64; 6], d: f64, l2: f64) -> [[f64; 3]; 3] {
 }
 
 /// Cholesky factor L (lower) of a symmetric positive definite 3 × 3 matrix.
-fn cholesky(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+pub(crate) fn cholesky(a: &[[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let mut l = [[0f64; 3]; 3];
     for i in 0..3 {
         for j in 0..=i {

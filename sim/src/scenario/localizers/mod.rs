@@ -355,6 +355,8 @@ pub enum LocalizerKind {
     ScanToMap(Box<systems::mapping::ScanToMapConfig>),
     /// Graph SLAM (from the robot's `slam` key).
     Graph(Box<systems::mapping::GraphSlamConfig>),
+    /// Rao-Blackwellized particle filter SLAM (from the robot's `slam` key).
+    Rbpf(Box<systems::mapping::RbpfConfig>),
 }
 
 impl LocalizerConfig {
@@ -367,7 +369,8 @@ impl LocalizerConfig {
             | LocalizerKind::DeMc(_)
             | LocalizerKind::DeOdometry(_)
             | LocalizerKind::ScanToMap(_)
-            | LocalizerKind::Graph(_) => None,
+            | LocalizerKind::Graph(_)
+            | LocalizerKind::Rbpf(_) => None,
         }
     }
 }

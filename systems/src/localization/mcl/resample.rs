@@ -107,6 +107,29 @@ impl BinSize {
     }
 }
 
+/// Low-variance (systematic) resampling, Probabilistic Robotics Table 4.4: the indices of `n`
+/// particles drawn from the (not necessarily normalised) weights `w` by a comb of `n` evenly
+/// spaced pointers starting at `u · total / n`, `u` ∈ [0, 1). Every particle of weight at least
+/// total/n is drawn at least once.
+pub fn low_variance_indices(w: &[f64], n: usize, u: f64) -> Vec<usize> {
+    if w.is_empty() {
+        return Vec::new();
+    }
+    let total: f64 = w.iter().sum();
+    let step = total.max(f64::MIN_POSITIVE) / n.max(1) as f64;
+    let mut out = Vec::with_capacity(n);
+    let (mut j, mut acc) = (0, w[0]);
+    for i in 0..n {
+        let pos = (u + i as f64) * step;
+        while pos > acc && j + 1 < w.len() {
+            j += 1;
+            acc += w[j];
+        }
+        out.push(j);
+    }
+    out
+}
+
 /// How many particles to draw.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CountLimits {
@@ -184,6 +207,22 @@ pub fn resample(
 mod tests {
     use super::*;
     use crate::core::stream_rng;
+
+    #[test]
+    fn low_variance_draws_in_proportion_to_weight() {
+        // weights 1 : 3 : 0 : 4 of 8 draws: exactly 1, 3, 0 and 4 copies whatever the offset
+        for u in [0.001, 0.3, 0.999] {
+            let idx = low_variance_indices(&[1.0, 3.0, 0.0, 4.0], 8, u);
+            let count = |k| idx.iter().filter(|&&i| i == k).count();
+            assert_eq!(
+                [count(0), count(1), count(2), count(3)],
+                [1, 3, 0, 4],
+                "u = {u}"
+            );
+            assert!(idx.windows(2).all(|p| p[0] <= p[1]));
+        }
+        assert!(low_variance_indices(&[], 4, 0.5).is_empty());
+    }
 
     #[test]
     fn quantile_matches_tables() {
