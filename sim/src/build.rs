@@ -286,7 +286,9 @@ pub fn new_filter(
         LocalizerKind::DeOdometry(c) => {
             Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
         }
-        LocalizerKind::ScanToMap(c) => Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()))),
+        LocalizerKind::ScanToMap(c) => {
+            Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()).with_rng(rng)))
+        }
         LocalizerKind::Graph(c) => Filter::Scan(Box::new(GraphSlam::new((**c).clone()))),
         LocalizerKind::Rbpf(c) => Filter::Scan(Box::new(RbpfSlam::new((**c).clone(), rng))),
     })

@@ -6,6 +6,7 @@
 //! * `wheel_odometry` — the encoders alone;
 //! * `de_scan_to_scan` — differential-evolution scan-to-scan odometry (the thesis's method,
 //!   [`systems::localization::de_odometry`]);
+//! * `scan_to_map_de` — scan_to_map with the DE matcher instead of Gauss-Newton;
 //! * `scan_to_map`, `rbpf`, `graph` — the three SLAM families 001_6ab7973871dfdca6.txt compares
 //!   (Hector-style, GMapping-style, Cartographer-style), with their default settings.
 //!
@@ -40,10 +41,11 @@ pub const EVAL_SPACING_M: f64 = 0.5;
 pub const SCENARIOS: [&str; 2] = ["maze_run", "hospital_loop"];
 
 /// The methods, in table order.
-pub const METHODS: [&str; 5] = [
+pub const METHODS: [&str; 6] = [
     "wheel_odometry",
     "de_scan_to_scan",
     "scan_to_map",
+    "scan_to_map_de",
     "rbpf",
     "graph",
 ];
@@ -199,7 +201,12 @@ pub fn judge_methods(
                 out
             }
             slam => {
-                let config = resolve_slam_config(Some(slam), None, &first.robot_pose)?;
+                // scan_to_map_de: scan_to_map with the DE matcher
+                let (kind, keys) = match slam.strip_suffix("_de") {
+                    Some(k) => (k, Some(("--methods", "matcher = \"de\"\n"))),
+                    None => (slam, None),
+                };
+                let config = resolve_slam_config(Some(kind), keys, &first.robot_pose)?;
                 let rng = stream_rng(scenario.seed, &robot, &format!("localizer/{slam}"));
                 let mut est = new_scan_estimator(&config.kind, rng)?;
                 feed_scans(est.as_mut(), &scans, pool, |_, _, _, _| {}).trajectory

@@ -7,6 +7,7 @@ use super::localizers::{LocalizerConfig, LocalizerKind};
 use super::resolve::{Checker, R};
 use serde::Deserialize;
 use systems::core::Pose2;
+use systems::mapping::de_map_match::DeMapMatcher;
 use systems::mapping::rbpf::proposal::SampleGrid;
 use systems::mapping::scan_to_map::OdometryPriorModel;
 use systems::mapping::{GraphSlamConfig, RbpfConfig, ScanToMapConfig};
@@ -103,6 +104,15 @@ pub struct SlamFile {
     pub llsamplestep: Option<f64>,
     pub lasamplerange: Option<f64>,
     pub lasamplestep: Option<f64>,
+    /// scan_to_map only: `gauss_newton` (default) or `de` (differential evolution).
+    pub matcher: Option<MatcherKind>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum MatcherKind {
+    GaussNewton,
+    De,
 }
 
 impl SlamFile {
@@ -123,10 +133,13 @@ impl SlamFile {
             ("map_update_min_a", self.map_update_min_a.is_some()),
             ("odometry_prior", self.odometry_prior.is_some()),
         ];
-        let foreign: &[(&'static str, bool)] = match self.kind {
-            SlamType::Rbpf => &matcher_keys,
-            SlamType::ScanToMap | SlamType::Graph => &rbpf_keys,
+        let mut foreign: Vec<(&'static str, bool)> = match self.kind {
+            SlamType::Rbpf => matcher_keys.to_vec(),
+            SlamType::ScanToMap | SlamType::Graph => rbpf_keys.to_vec(),
         };
+        if self.kind != SlamType::ScanToMap {
+            foreign.push(("matcher", self.matcher.is_some()));
+        }
         foreign
             .iter()
             .filter(|(_, given)| *given)
@@ -168,8 +181,9 @@ pub(super) fn resolve_slam(
             );
         }
         if let Some(k) = s.foreign_keys().first() {
-            let users = match s.kind {
-                SlamType::Rbpf => "`scan_to_map` and `graph`",
+            let users = match (s.kind, *k) {
+                (_, "matcher") => "`scan_to_map`",
+                (SlamType::Rbpf, _) => "`scan_to_map` and `graph`",
                 _ => "`rbpf`",
             };
             return c.err(
@@ -234,6 +248,7 @@ pub(super) fn resolve_slam(
                 _ => Some(OdometryPriorModel::default()),
             },
             init_pose: *start,
+            de_matcher: (s.matcher == Some(MatcherKind::De)).then(DeMapMatcher::default),
         };
         let kind = match s.kind {
             SlamType::Rbpf => LocalizerKind::Rbpf(Box::new(rbpf_config(c, &sp, s, config)?)),

@@ -206,6 +206,18 @@ mod tests {
                 && e.contains("`levels` applies to `scan_to_map` and `graph`"),
             "{e}"
         );
+        let e = err("graph", "matcher = \"de\"\n");
+        assert!(e.contains("`matcher` applies to `scan_to_map`"), "{e}");
+        let c = resolve_slam_config(
+            Some("scan_to_map"),
+            Some(("g.toml", "matcher = \"de\"\n")),
+            &start(),
+        )
+        .unwrap();
+        let LocalizerKind::ScanToMap(s) = &c.kind else {
+            panic!("{c:?}")
+        };
+        assert!(s.de_matcher.is_some());
         let e = err("graph", "\nparticles = 30\n");
         assert!(
             e.starts_with("g.toml:2:") && e.contains("`particles` applies to `rbpf`"),

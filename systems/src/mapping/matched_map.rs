@@ -74,6 +74,11 @@ impl MatchedMap {
         }
     }
 
+    /// The pyramid matchers read; None before the first scan is inserted.
+    pub fn pyramid(&self) -> Option<&MapPyramid> {
+        self.pyramid.as_ref()
+    }
+
     /// Matches `points` (end points in the robot's base frame) from `guess` (the base pose in the
     /// map frame); None before the first scan is inserted.
     pub fn match_points(

@@ -10,6 +10,7 @@
 //! * [`matched_map`] — a map matched against and inserted into scan after scan (map, mirror,
 //!   pyramid);
 //! * [`scan_to_map`] — scan-to-map SLAM (Hector-style Gauss-Newton with an odometry prior);
+//! * [`de_map_match`] — differential evolution as scan-to-map SLAM's alternative matcher;
 //! * [`graph_slam`] — graph SLAM: submaps, branch-and-bound loop closure, pose-graph optimization
 //!   (Cartographer-style);
 //! * [`rbpf`] — Rao-Blackwellized particle filter SLAM (GMapping-style: a map per particle,
@@ -20,6 +21,7 @@
 //! * `grow` — a grid's extent on a fixed cell lattice and growth by whole blocks (private).
 
 pub mod align;
+pub mod de_map_match;
 pub mod graph_slam;
 mod grow;
 mod insert;

@@ -10,9 +10,10 @@
 //! MIT corridor) — leaves the estimate on the odometry along the corridor axis instead of
 //! sliding. The map frame is the world frame: the SLAM starts at the robot's known start pose.
 
+use super::de_map_match::{DeMapMatcher, match_de};
 use super::matched_map::{MatchedMap, base_points};
 use super::occupancy::OccupancyParams;
-use crate::core::{Pose2, wrap_angle};
+use crate::core::{Pose2, SimRng, wrap_angle};
 use crate::localization::{PoseEstimate, ScanEstimator};
 use crate::matching::ProbGrid;
 use crate::matching::gauss_newton::{GaussNewtonParams, OdometryPrior};
@@ -38,6 +39,9 @@ pub struct ScanToMapConfig {
     pub prior: Option<OdometryPriorModel>,
     /// The map frame's pose of the robot at its first scan.
     pub init_pose: Pose2,
+    /// Match by differential evolution instead of Gauss-Newton ([`super::de_map_match`]; the
+    /// filter's random stream must be given with [`ScanToMapSlam::with_rng`]).
+    pub de_matcher: Option<DeMapMatcher>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,6 +74,7 @@ impl Default for ScanToMapConfig {
             beam_stride: 2,
             prior: Some(OdometryPriorModel::default()),
             init_pose: Pose2::default(),
+            de_matcher: None,
         }
     }
 }
@@ -106,6 +111,8 @@ pub struct ScanToMapSlam {
     /// Matches run, and those that did not converge.
     pub matches: usize,
     pub unconverged: usize,
+    /// The DE matcher's random stream.
+    rng: Option<SimRng>,
 }
 
 impl ScanToMapSlam {
@@ -121,7 +128,14 @@ impl ScanToMapSlam {
             path: Vec::new(),
             matches: 0,
             unconverged: 0,
+            rng: None,
         }
+    }
+
+    /// Gives the random stream the DE matcher draws from.
+    pub fn with_rng(mut self, rng: SimRng) -> Self {
+        self.rng = Some(rng);
+        self
     }
 
     /// The robot's pose in the map frame.
@@ -142,7 +156,12 @@ impl ScanToMapSlam {
         };
         self.last_odom = Some(*odom);
         let points = base_points(scan, mount, self.config.beam_stride);
-        let t = track(&self.map, &self.config, self.pose, &delta, &points);
+        let t = match (&self.config.de_matcher, self.rng.as_mut()) {
+            (Some(de), Some(rng)) => {
+                track_de(&self.map, &self.config, de, rng, self.pose, &delta, &points)
+            }
+            _ => track(&self.map, &self.config, self.pose, &delta, &points),
+        };
         if let Some(converged) = t.converged {
             self.matches += 1;
             if !converged {
@@ -200,6 +219,41 @@ pub(super) fn track(
         }
     }
     out
+}
+
+/// [`track`] with the DE matcher: the prediction when the map is empty, else DE's pose.
+fn track_de(
+    map: &MatchedMap,
+    config: &ScanToMapConfig,
+    de: &DeMapMatcher,
+    rng: &mut SimRng,
+    pose: Pose2,
+    delta: &Pose2,
+    points: &[[f32; 2]],
+) -> Tracked {
+    let predicted = pose.compose(delta);
+    let prior = config.prior.map(|m| m.prior(predicted, delta));
+    match map.pyramid() {
+        Some(pyr) if points.len() >= 3 => {
+            match match_de(pyr, points, predicted, prior.as_ref(), de, rng) {
+                Some((pose, covariance)) => Tracked {
+                    pose,
+                    covariance,
+                    converged: Some(true),
+                },
+                None => Tracked {
+                    pose: predicted,
+                    covariance: [[0.0; 3]; 3],
+                    converged: Some(false),
+                },
+            }
+        }
+        _ => Tracked {
+            pose: predicted,
+            covariance: [[0.0; 3]; 3],
+            converged: None,
+        },
+    }
 }
 
 /// Whether the robot at `pose` moved far enough from `last` (the pose of the last insertion) for
