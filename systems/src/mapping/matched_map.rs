@@ -25,7 +25,7 @@ impl MatchedMap {
     /// An empty, growing map of `resolution` with a pyramid of `levels`.
     pub fn new(resolution: f64, params: OccupancyParams, levels: usize) -> Self {
         MatchedMap {
-            map: LogOddsMap::new(resolution, params),
+            map: LogOddsMap::anchored(resolution, params, slam_anchor(resolution)),
             prob: ProbGrid::new(0, 0, resolution, [0.0, 0.0], 0.5),
             pyramid: None,
             levels: levels.max(1),
@@ -91,6 +91,17 @@ impl MatchedMap {
         let pyramid = self.pyramid.as_ref()?;
         Some(match_scan(pyramid, points, guess, prior, params))
     }
+}
+
+/// Where the SLAM maps' cell lattice is anchored: half a cell off the world origin. The
+/// simulated worlds are grids whose walls lie on the faces of their cells (5 cm on the bundled
+/// maps); a SLAM map of the same resolution on the same lattice has every wall on a cell face,
+/// where range noise splits the hits between the two cells either side and the interpolated map
+/// is flat across the wall. Graph SLAM's submaps then tracked and closed loops with
+/// centimetre biases (hospital_loop at 5 cm: ATE 0.081 m after optimization, 0.058 m without
+/// loop closures); half a cell off, 0.018 m. Real data has no such alignment.
+pub fn slam_anchor(resolution: f64) -> [f64; 2] {
+    [resolution / 2.0, resolution / 2.0]
 }
 
 /// The end points of a scan's returns in the robot's base frame (the laser at `mount`), every

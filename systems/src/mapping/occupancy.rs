@@ -141,7 +141,12 @@ impl LogOddsMap {
     /// An empty map that grows to hold whatever is inserted. The cell lattice is anchored at the
     /// world origin: cell corners lie on multiples of `resolution`.
     pub fn new(resolution: f64, params: OccupancyParams) -> Self {
-        Self::build(Extent::empty(resolution, [0.0, 0.0]), true, params)
+        Self::anchored(resolution, params, [0.0, 0.0])
+    }
+
+    /// An empty, growing map whose cell corners lie on `anchor` + multiples of `resolution`.
+    pub fn anchored(resolution: f64, params: OccupancyParams, anchor: [f64; 2]) -> Self {
+        Self::build(Extent::empty(resolution, anchor), true, params)
     }
 
     /// A map of fixed bounds: beams are clipped to it, returns outside it are dropped.

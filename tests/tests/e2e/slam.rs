@@ -13,8 +13,7 @@ fn hospital_loop_with(slam: &str) -> String {
 #[test]
 fn scan_to_map_and_graph_slam_track_two_laps_of_the_hospital_while_odometry_drifts() {
     let text = hospital_loop_with(
-        "[[robots.slam]]\ntype = \"scan_to_map\"\nresolution = 0.04\n\
-         [[robots.slam]]\ntype = \"graph\"\nresolution = 0.04",
+        "[[robots.slam]]\ntype = \"scan_to_map\"\n[[robots.slam]]\ntype = \"graph\"",
     );
     let out = run_scenario(&scenario(&text), &RunOptions::default()).expect("runs");
     let r = &out.summary.robots[0];
@@ -39,7 +38,7 @@ fn scan_to_map_and_graph_slam_track_two_laps_of_the_hospital_while_odometry_drif
     assert_eq!(f.poses, g.estimates, "one optimized pose per scan");
     let ate = f.ate_rmse_m.unwrap();
     assert!(ate < 0.05, "graph SLAM ATE after optimization {ate} m");
-    // loop closure beats scan-to-map alone on the same cells
+    // loop closure beats scan-to-map alone (both with their default 5 cm cells)
     assert!(
         ate < scan_to_map_ate,
         "graph {ate} m, scan-to-map {scan_to_map_ate} m"
@@ -122,5 +121,5 @@ fn in_the_maze_scan_to_scan_matching_drifts_and_matching_against_the_map_does_no
     assert!(ate(s2m) < 0.1 && ate(rbpf) < 0.15, "{s2m:?} {rbpf:?}");
     // and the maps built from their trajectories show it
     assert!(s2m.map_quality.precision > de.map_quality.precision);
-    assert!(s2m.map_quality.precision > 0.9 && rbpf.map_quality.precision > 0.85);
+    assert!(s2m.map_quality.precision > 0.85 && rbpf.map_quality.precision > 0.85);
 }

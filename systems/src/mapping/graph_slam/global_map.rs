@@ -64,7 +64,11 @@ impl CachedMap {
         if stale {
             *guard = Some(Cache {
                 poses: Vec::new(),
-                map: LogOddsMap::new(self.resolution, self.params.clone()),
+                map: LogOddsMap::anchored(
+                    self.resolution,
+                    self.params.clone(),
+                    super::super::matched_map::slam_anchor(self.resolution),
+                ),
             });
         }
         let Some(cache) = guard.as_mut() else {

@@ -39,7 +39,8 @@ pub struct LoopClosureConfig {
     /// Floor of a constraint's standard deviations [x, y (m), θ (rad)], added to the match's
     /// own covariance (on hospital_loop, 0.03 m / 0.01 rad made the closures pull the graph
     /// off by their few-centimetre biases: final ATE 0.095 m at 5 cm cells, 0.040 m at 4 cm,
-    /// against 0.081 / 0.021 with these).
+    /// against 0.081 / 0.021 with these; measured before the SLAM lattice was offset by half a
+    /// cell, [`crate::mapping::matched_map::slam_anchor`]).
     pub std: [f64; 3],
     /// Huber δ of a loop-closure constraint, in whitened units.
     pub huber: f64,
