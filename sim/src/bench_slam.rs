@@ -57,6 +57,12 @@ pub fn run_slam_bench(o: &SlamBenchOptions) -> anyhow::Result<Vec<SlamBenchRow>>
         }
         scenario.duration = scenario.duration.min(d);
     }
+    // every mode resolves before the (long) simulation
+    let home = systems::core::Pose2::default();
+    for mode in &o.modes {
+        resolve_slam_config(Some(mode), None, &home)
+            .map_err(|e| anyhow::anyhow!("--modes: {e}"))?;
+    }
     let log = simulate(
         &scenario,
         &SlamExperimentOptions {

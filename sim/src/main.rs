@@ -160,7 +160,7 @@ enum BenchCommand {
         #[arg(long, default_value_t = 1)]
         threads: usize,
         /// Simulate only this many seconds of the scenario (quick checks).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         duration: Option<f64>,
     },
     /// DE scan-matching time per alignment of 1081-beam hospital scans (one core).

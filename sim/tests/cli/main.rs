@@ -231,3 +231,28 @@ fn bench_markov_grid_prints_json_lines() {
     let modes: Vec<&str> = rows.iter().map(|r| r["mode"].as_str().unwrap()).collect();
     assert_eq!(modes, ["global", "selective"]);
 }
+
+#[test]
+fn slam_experiment_and_bench_refuse_bad_options_before_simulating() {
+    let dir = tempfile::tempdir().unwrap();
+    expect_failure(
+        &[
+            "experiment",
+            "maze-slam",
+            "--methods",
+            "scan_to_map,gmapping",
+        ],
+        dir.path(),
+        &["--methods", "unknown method `gmapping`"],
+    );
+    expect_failure(
+        &["bench", "slam", "--modes", "hector"],
+        dir.path(),
+        &["--modes", "hector"],
+    );
+    expect_failure(
+        &["bench", "slam", "--duration", "-5"],
+        dir.path(),
+        &["--duration", "positive"],
+    );
+}
