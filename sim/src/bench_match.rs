@@ -9,6 +9,7 @@
 use crate::experiment::de_match::{MAX_XY_M, PERIOD_S, STEPS, thesis_de};
 use crate::experiment::scan_pairs::{LMS100_BEAMS, bundled, capture, draw_pairs};
 use crate::match_cmd::TransformError;
+use crate::stats::{median, quantile};
 use serde::Serialize;
 use systems::core::stream_rng;
 use systems::matching::{MatchConfig, Strategy, ThesisFitness, match_scans};
@@ -32,22 +33,6 @@ struct BenchRow {
     /// Share of the pairs aligned within 0.1 m and 2° (a sanity check, not the experiment).
     right_pct: f64,
     threads: usize,
-}
-
-fn sorted(mut v: Vec<f64>) -> Vec<f64> {
-    v.sort_by(f64::total_cmp);
-    v
-}
-
-fn median_of(v: &[f64]) -> f64 {
-    let n = v.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 pub fn run_de_match_bench(o: &DeMatchBenchOptions) -> anyhow::Result<()> {
@@ -98,17 +83,16 @@ pub fn run_de_match_bench(o: &DeMatchBenchOptions) -> anyhow::Result<()> {
         }
         let n = ms.len();
         let mean = ms.iter().sum::<f64>() / n as f64;
-        let ms = sorted(ms);
-        let evals = sorted(evals);
+        let (mut ms, mut evals) = (ms, evals);
         let row = BenchRow {
             bench: "de-match",
             method: name,
             beams: LMS100_BEAMS,
             pairs: n,
-            ms_per_alignment: median_of(&ms),
+            ms_per_alignment: median(&mut ms),
             mean_ms: mean,
-            p90_ms: ms[((n - 1) as f64 * 0.9).round() as usize],
-            median_evaluations: median_of(&evals).round() as u64,
+            p90_ms: quantile(&mut ms, 0.9),
+            median_evaluations: median(&mut evals).round() as u64,
             right_pct: 100.0 * right as f64 / n as f64,
             threads: 1,
         };

@@ -13,6 +13,7 @@ use crate::experiment::scan_pairs::bundled;
 use crate::experiment::slam_compare::{SlamExperimentOptions, simulate};
 use crate::scenario::slam_file::resolve_slam_config;
 use crate::slam_cmd::feed::feed_scans;
+use crate::stats::{median, quantile};
 use serde::Serialize;
 use systems::core::{KernelPool, stream_rng};
 
@@ -40,13 +41,6 @@ pub struct SlamBenchRow {
     pub finish_ms: f64,
     /// The target (× real time), if it sets one for this mode.
     pub target: Option<f64>,
-}
-
-fn percentile(sorted: &[f64], q: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    sorted[((sorted.len() - 1) as f64 * q).round() as usize]
 }
 
 pub fn run_slam_bench(o: &SlamBenchOptions) -> anyhow::Result<Vec<SlamBenchRow>> {
@@ -89,7 +83,6 @@ pub fn run_slam_bench(o: &SlamBenchOptions) -> anyhow::Result<Vec<SlamBenchRow>>
         }
         let run = feed_scans(est.as_mut(), &scans, &pool, |_, _, _, _| {});
         let mut ms = run.update_ms.clone();
-        ms.sort_by(f64::total_cmp);
         let compute_s = (ms.iter().sum::<f64>() + run.finish_ms) / 1e3;
         let row = SlamBenchRow {
             mode: mode.clone(),
@@ -98,8 +91,8 @@ pub fn run_slam_bench(o: &SlamBenchOptions) -> anyhow::Result<Vec<SlamBenchRow>>
             log_duration_s: duration,
             compute_s,
             real_time_factor: duration / compute_s.max(1e-9),
-            median_ms_per_scan: percentile(&ms, 0.5),
-            p95_ms_per_scan: percentile(&ms, 0.95),
+            median_ms_per_scan: median(&mut ms),
+            p95_ms_per_scan: quantile(&mut ms, 0.95),
             mean_ms_per_scan: ms.iter().sum::<f64>() / ms.len().max(1) as f64,
             finish_ms: run.finish_ms,
             target: match mode.as_str() {

@@ -19,6 +19,7 @@ pub mod scans;
 pub mod scenario;
 pub mod script;
 pub mod slam_cmd;
+pub mod stats;
 pub mod summary;
 
 pub use run_exports::RunExports;

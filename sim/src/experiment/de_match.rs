@@ -35,6 +35,7 @@ use super::scan_pairs::{
 };
 use crate::match_cmd::{THESIS_CORRELATION_FILTER, TransformError, strategy_cli_name};
 use crate::scans::write_scans;
+use crate::stats::{median, quantile};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -202,28 +203,6 @@ pub struct Row {
     pub p90_ms: f64,
     pub median_evaluations: u64,
     pub seed: u64,
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
-fn quantile(v: &mut [f64], q: f64) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    let k = ((v.len() as f64 - 1.0) * q).round() as usize;
-    v[k.min(v.len() - 1)]
 }
 
 /// Sample standard deviation (n − 1); `None` for fewer than two values.

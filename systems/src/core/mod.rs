@@ -3,6 +3,7 @@
 
 pub mod clock;
 pub mod ids;
+pub mod moments;
 pub mod pool;
 pub mod pose;
 pub mod rng;

@@ -7,6 +7,7 @@
 //! globally within the window instead of by gradient, as the thesis proposes for its maze drift
 //! ("match each scan against the map built so far").
 
+use crate::core::moments::weighted_scatter;
 use crate::core::{Pose2, SimRng, wrap_angle};
 use crate::matching::gauss_newton::OdometryPrior;
 use crate::matching::map_pyramid::MapPyramid;
@@ -92,14 +93,11 @@ pub fn match_de(
     let mean: Vec<f64> = (0..3)
         .map(|k| out.population.iter().map(|v| v[k]).sum::<f64>() / n)
         .collect();
-    let mut cov = [[0.0; 3]; 3];
-    for v in &out.population {
-        for i in 0..3 {
-            for j in 0..3 {
-                cov[i][j] += (v[i] - mean[i]) * (v[j] - mean[j]) / n;
-            }
-        }
-    }
+    let cov = weighted_scatter(
+        out.population
+            .iter()
+            .map(|v| ([v[0] - mean[0], v[1] - mean[1], v[2] - mean[2]], 1.0)),
+    );
     let b = out.best;
     Some((Pose2::new(b[0], b[1], wrap_angle(b[2])), cov))
 }

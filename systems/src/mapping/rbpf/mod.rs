@@ -32,6 +32,7 @@ pub mod tile_map;
 use super::insert::{Beam, LogOddsModel};
 use super::matched_map::base_points;
 use super::occupancy::{OccupancyParams, log_odds};
+use crate::core::moments::weighted_scatter;
 use crate::core::{Pose2, SimRng, wrap_angle};
 use crate::localization::mcl::resample::low_variance_indices;
 use crate::localization::motion_model::{OdometryMotionModel, moved_enough};
@@ -282,19 +283,7 @@ impl RbpfSlam {
 
     /// Normalises the weights, picks the best particle, resamples when N_eff is low.
     fn reweight_and_resample(&mut self) {
-        let top = self
-            .particles
-            .iter()
-            .map(|p| p.log_w)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let w: Vec<f64> = if top.is_finite() {
-            self.particles
-                .iter()
-                .map(|p| (p.log_w - top).exp())
-                .collect()
-        } else {
-            vec![1.0; self.particles.len()] // every particle impossible: start over evenly
-        };
+        let w = self.relative_weights();
         let (sum, sum2) = (w.iter().sum::<f64>(), w.iter().map(|x| x * x).sum::<f64>());
         self.stats.n_eff = sum * sum / sum2;
         self.best = (0..w.len()).fold(0, |b, i| if w[i] > w[b] { i } else { b });
@@ -316,36 +305,40 @@ impl RbpfSlam {
 
     /// Publishes `pose` with the spread of the particles (weighted) as its covariance.
     fn publish(&mut self, pose: Pose2) {
+        let best = self.particles[self.best].pose;
+        let spread = self
+            .particles
+            .iter()
+            .zip(self.relative_weights())
+            .map(|(p, w)| {
+                let d = p.pose;
+                (
+                    [d.x - best.x, d.y - best.y, wrap_angle(d.theta - best.theta)],
+                    w,
+                )
+            });
+        self.estimate = Some(PoseEstimate {
+            pose,
+            covariance: weighted_scatter(spread),
+            weight: 1.0,
+        });
+    }
+
+    /// The weights relative to the largest (all 1 when every particle is impossible: the
+    /// filter starts over evenly).
+    fn relative_weights(&self) -> Vec<f64> {
         let top = self
             .particles
             .iter()
             .map(|p| p.log_w)
             .fold(f64::NEG_INFINITY, f64::max);
-        let w: Vec<f64> = self
-            .particles
+        if !top.is_finite() {
+            return vec![1.0; self.particles.len()];
+        }
+        self.particles
             .iter()
             .map(|p| (p.log_w - top).exp())
-            .collect();
-        let total: f64 = w.iter().sum();
-        let best = self.particles[self.best].pose;
-        let mut cov = [[0.0; 3]; 3];
-        for (p, wi) in self.particles.iter().zip(&w) {
-            let d = [
-                p.pose.x - best.x,
-                p.pose.y - best.y,
-                wrap_angle(p.pose.theta - best.theta),
-            ];
-            for a in 0..3 {
-                for b in 0..3 {
-                    cov[a][b] += wi / total * d[a] * d[b];
-                }
-            }
-        }
-        self.estimate = Some(PoseEstimate {
-            pose,
-            covariance: cov,
-            weight: 1.0,
-        });
+            .collect()
     }
 }
 

@@ -6,6 +6,7 @@
 //! μ = Σ x_j τ_j / η, Σ = Σ τ_j (x_j − μ)(x_j − μ)ᵀ / η, η = Σ τ_j; the particle's new pose is
 //! drawn from N(μ, Σ) and its weight multiplied by η.
 
+use crate::core::moments::weighted_scatter;
 use crate::core::{Pose2, wrap_angle};
 use crate::matching::gauss_newton::cholesky;
 
@@ -84,15 +85,12 @@ pub fn fit(best: &Pose2, grid: &SampleGrid, mut log_tau: impl FnMut(&Pose2) -> f
             mu[k] += o[k] * wi / eta;
         }
     }
-    let mut cov = [[0.0; 3]; 3];
-    for (o, wi) in offsets.iter().zip(&w) {
-        let d = [o[0] - mu[0], o[1] - mu[1], o[2] - mu[2]];
-        for a in 0..3 {
-            for b in 0..3 {
-                cov[a][b] += wi * d[a] * d[b] / eta;
-            }
-        }
-    }
+    let cov = weighted_scatter(
+        offsets
+            .iter()
+            .zip(&w)
+            .map(|(o, &wi)| ([o[0] - mu[0], o[1] - mu[1], o[2] - mu[2]], wi)),
+    );
     Proposal {
         mean: Pose2::new(
             best.x + mu[0],
