@@ -22,8 +22,12 @@
 //!    Gauss–Newton, [`super::refine`], on the coarse set) and judged by
 //!    `inliers − violation_weight · violations`: inliers are current points within
 //!    `inlier_distance` of the reference surface, violations are points of either scan that the
-//!    alignment puts in space the other scan saw as free ([`super::visibility`]).
-//! 6. **Final refinement**: the best screened candidates are refined on the fine set and judged
+//!    alignment puts in space the other scan saw as free ([`super::visibility`]). A compact run
+//!    of violating points (shorter than `blob_extent`) is a person or robot that moved between
+//!    the scans and counts once: counted point by point, two people ahead made a 180° flip of a
+//!    corridor win.
+//! 6. **Final refinement**: the best screened candidates (no two alike), plus the best of up to
+//!    `extra_rotations` rotations not yet among them, are refined on the fine set and judged
 //!    again; the best wins.
 //!
 //!    **Rotation polish**: when the winner explains less than `polish_below` of the fine set
@@ -71,8 +75,10 @@ pub struct ImprovedConfig {
     pub fine_points: usize,
     /// Candidates (best correlation first) refined briefly and judged.
     pub screened: usize,
-    /// Screened candidates (best judged first) refined fully.
+    /// Screened candidates (best judged first, no two within 0.1 m and 1°) refined fully.
     pub finalists: usize,
+    /// Further finalists, each the best screened candidate of a rotation not yet among them.
+    pub extra_rotations: usize,
     /// Gauss–Newton iterations of the brief and the full refinement.
     pub screen_iterations: usize,
     pub final_iterations: usize,
@@ -84,6 +90,9 @@ pub struct ImprovedConfig {
     pub violation_margin: f32,
     /// Weight of a violation against an inlier in the judgement.
     pub violation_weight: f32,
+    /// A run of violating points shorter than this (m) is one moving object and counts once
+    /// (0 counts every point).
+    pub blob_extent: f32,
     /// A refined translation whose least-constrained direction carries less than this share of
     /// the information of the best-constrained one is searched along that direction.
     pub weak_ratio: f64,
@@ -116,12 +125,14 @@ impl Default for ImprovedConfig {
             fine_points: 400,
             screened: 24,
             finalists: 3,
+            extra_rotations: 2,
             screen_iterations: 6,
             final_iterations: 15,
             gate: 0.5,
             inlier_distance: 0.05,
             violation_margin: 0.2,
             violation_weight: 8.0,
+            blob_extent: 0.7,
             weak_ratio: 0.3,
             weak_search: 0.6,
             weak_step: 0.05,
@@ -202,6 +213,13 @@ impl ImprovedConfig {
                 expected: "a finite weight >= 0",
             });
         }
+        if !(self.blob_extent.is_finite() && self.blob_extent >= 0.0) {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.blob_extent",
+                value: self.blob_extent as f64,
+                expected: "a finite length >= 0",
+            });
+        }
         let count = |name, v: usize, max: usize, expected| {
             if (1..=max).contains(&v) {
                 Ok(())
@@ -239,6 +257,13 @@ impl ImprovedConfig {
         )?;
         count("improved.screened", self.screened, 10_000, "1 ..= 10000")?;
         count("improved.finalists", self.finalists, 10_000, "1 ..= 10000")?;
+        if self.extra_rotations > 10_000 {
+            return Err(MatchError::InvalidParameter {
+                name: "improved.extra_rotations",
+                value: self.extra_rotations as f64,
+                expected: "0 ..= 10000",
+            });
+        }
         count(
             "improved.screen_iterations",
             self.screen_iterations,
@@ -283,15 +308,81 @@ struct Judge<'a> {
     end_tangent: f32,
     margin: f32,
     weight: f32,
+    blob_extent: f32,
+}
+
+/// Free-space violations counted by runs. Consecutive violating points of one scan (in scan
+/// order, each within [`RUN_GAP`] of the previous) form a run; a run whose end points lie less
+/// than `blob_extent` apart is a compact object — in a right alignment, a person or robot that
+/// moved between the scans — and counts once, any longer run counts every point. A wrong
+/// alignment pushes whole walls through free space, which stays expensive.
+struct ViolationRuns {
+    blob_extent: f32,
+    total: usize,
+    first: [f32; 2],
+    last: [f32; 2],
+    len: usize,
+}
+
+/// Largest gap (m) between successive points of one violation run.
+const RUN_GAP: f32 = 0.25;
+
+impl ViolationRuns {
+    fn new(blob_extent: f32) -> Self {
+        ViolationRuns {
+            blob_extent,
+            total: 0,
+            first: [0.0; 2],
+            last: [0.0; 2],
+            len: 0,
+        }
+    }
+
+    #[inline]
+    fn violation(&mut self, p: [f32; 2]) {
+        if self.len > 0 && dist2(self.last, p) > RUN_GAP * RUN_GAP {
+            self.close();
+        }
+        if self.len == 0 {
+            self.first = p;
+        }
+        self.last = p;
+        self.len += 1;
+    }
+
+    /// A point that does not violate ends the current run.
+    #[inline]
+    fn other(&mut self) {
+        if self.len > 0 {
+            self.close();
+        }
+    }
+
+    fn close(&mut self) {
+        let compact = dist2(self.first, self.last) < self.blob_extent * self.blob_extent;
+        self.total += if compact { 1 } else { self.len };
+        self.len = 0;
+    }
+
+    fn finish(mut self) -> usize {
+        self.other();
+        self.total
+    }
+}
+
+#[inline(always)]
+fn dist2(a: [f32; 2], b: [f32; 2]) -> f32 {
+    (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1])
 }
 
 impl Judge<'_> {
     /// (inliers of `current`, free-space violations of both sets) for transform `t`.
+    /// Violations are counted per [`ViolationRuns`]: a compact run is one moving object.
     fn count(&self, current: &[[f32; 2]], reference: &[[f32; 2]], t: &Vector) -> (usize, usize) {
         let (s, c) = t[2].sin_cos();
         let (s, c, tx, ty) = (s as f32, c as f32, t[0] as f32, t[1] as f32);
         let mut inliers = 0;
-        let mut violations = 0;
+        let mut runs = ViolationRuns::new(self.blob_extent);
         for b in current {
             let q = [c * b[0] - s * b[1] + tx, s * b[0] + c * b[1] + ty];
             if self
@@ -300,10 +391,14 @@ impl Judge<'_> {
                 .is_some_and(|d| d <= self.inlier_distance)
             {
                 inliers += 1;
+                runs.other();
             } else if self.ref_image.violates(q, self.margin) {
-                violations += 1;
+                runs.violation(*b);
+            } else {
+                runs.other();
             }
         }
+        runs.other();
         // reference points in the current frame: b = Rᵀ (a − t)
         for a in reference {
             let (dx, dy) = (a[0] - tx, a[1] - ty);
@@ -311,10 +406,12 @@ impl Judge<'_> {
                 .cur_image
                 .violates([c * dx + s * dy, -s * dx + c * dy], self.margin)
             {
-                violations += 1;
+                runs.violation(*a);
+            } else {
+                runs.other();
             }
         }
-        (inliers, violations)
+        (inliers, runs.finish())
     }
 
     /// Inliers of `current` only.
@@ -332,11 +429,43 @@ impl Judge<'_> {
             .count()
     }
 
-    /// The judged score `inliers − weight · violations`.
+    /// The judged score `inliers − weight · violations`, and the inliers.
     fn score(&self, current: &[[f32; 2]], reference: &[[f32; 2]], t: &Vector) -> (f64, usize) {
-        let (inl, viol) = self.count(current, reference, t);
-        (inl as f64 - self.weight as f64 * viol as f64, inl)
+        let n = self.count(current, reference, t);
+        (n.0 as f64 - self.weight as f64 * n.1 as f64, n.0)
     }
+}
+
+/// The screened candidates (best first) that are refined fully: the best `n` that are not
+/// duplicates of each other (within 0.1 m and 1°), then up to `extra_rotations` more, each the
+/// best candidate of a rotation more than 10° from every one taken so far. Screening judges on
+/// the coarse sets, where a few people in view cost a right answer as much as a shift costs a
+/// flipped one; without the extra rotations the slots fill with shifted copies of one flip.
+fn pick_finalists(screened: &[(Vector, f64)], n: usize, extra_rotations: usize) -> Vec<Vector> {
+    let near = |a: &Vector, b: &Vector, xy: f64, theta_deg: f64| {
+        (a[0] - b[0]).hypot(a[1] - b[1]) <= xy
+            && wrap_angle(a[2] - b[2]).abs() <= theta_deg.to_radians()
+    };
+    let mut picked: Vec<Vector> = Vec::with_capacity(n + extra_rotations);
+    for (t, _) in screened {
+        if picked.len() == n {
+            break;
+        }
+        if !picked.iter().any(|p| near(p, t, 0.1, 1.0)) {
+            picked.push(*t);
+        }
+    }
+    let mut extra = 0;
+    for (t, _) in screened {
+        if extra == extra_rotations {
+            break;
+        }
+        if !picked.iter().any(|p| near(p, t, f64::INFINITY, 10.0)) {
+            picked.push(*t);
+            extra += 1;
+        }
+    }
+    picked
 }
 
 /// Runs the pipeline of the module docs. Points must be finite and both sets non-empty.
@@ -376,6 +505,7 @@ pub(crate) fn match_improved(
         end_tangent: 1.2 * cfg.inlier_distance,
         margin: cfg.violation_margin,
         weight: cfg.violation_weight,
+        blob_extent: cfg.blob_extent,
     };
     // 3. rotation hypotheses
     let max_theta = if bounds.theta_periodic() {
@@ -495,7 +625,7 @@ pub(crate) fn match_improved(
         (r, score, inl)
     };
     let mut best: Option<(Vector, f64, usize)> = None;
-    for &(t, _) in screened.iter().take(cfg.finalists) {
+    for t in pick_finalists(&screened, cfg.finalists, cfg.extra_rotations) {
         let c = finalize(t, &full);
         evaluations += cfg.final_iterations as u64 + 1;
         if best.is_none_or(|b| c.1 > b.1) {
@@ -544,4 +674,41 @@ pub(crate) fn match_improved(
         inliers: inliers as f64 / n_fine,
         evaluations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ViolationRuns;
+
+    fn total(points: &[Option<[f32; 2]>], blob_extent: f32) -> usize {
+        let mut runs = ViolationRuns::new(blob_extent);
+        for p in points {
+            match p {
+                Some(p) => runs.violation(*p),
+                None => runs.other(),
+            }
+        }
+        runs.finish()
+    }
+
+    #[test]
+    fn a_compact_run_counts_once_a_wall_counts_every_point() {
+        // a person: 9 points over 0.4 m; a wall: 30 points over 1.5 m
+        let person: Vec<_> = (0..9).map(|k| Some([5.0, 0.05 * k as f32])).collect();
+        let wall: Vec<_> = (0..30)
+            .map(|k| Some([2.0 + 0.05 * k as f32, 3.0]))
+            .collect();
+        assert_eq!(total(&person, 0.7), 1);
+        assert_eq!(total(&wall, 0.7), 30);
+        // a non-violating point or a gap over 0.25 m splits runs
+        let mut two = person.clone();
+        two.push(None);
+        two.extend(person.iter().cloned());
+        assert_eq!(total(&two, 0.7), 2);
+        let far: Vec<_> = [[0.0, 0.0], [0.1, 0.0], [0.5, 0.0]].map(Some).to_vec();
+        assert_eq!(total(&far, 0.7), 2);
+        // blob_extent 0 counts every point
+        assert_eq!(total(&person, 0.0), 9);
+        assert_eq!(total(&[], 0.7), 0);
+    }
 }
