@@ -9,6 +9,7 @@
 //! - [`navigator`]: task queues (deliveries, trips, waits: [`tasks`]), stop-and-wait at
 //!   obstacles, re-planning, and the yield rule between robots ([`fleet`]); [`drive`] holds its
 //!   systems;
+//! - [`road_planner`]: A* on the outdoor road graph with the no-U-turn rule;
 //! - [`behaviour`]: simple behaviours without a planner (waypoints, wander) with reactive
 //!   avoidance ([`avoid`]).
 
@@ -23,6 +24,7 @@ pub mod local_map;
 pub mod navigator;
 pub mod open_list;
 pub mod outcomes;
+pub mod road_planner;
 pub mod shared_costmaps;
 pub mod shortcut;
 pub mod tasks;
