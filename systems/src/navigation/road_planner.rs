@@ -284,6 +284,48 @@ mod tests {
     }
 
     #[test]
+    fn the_park_short_route_goes_round_a_loop_instead_of_turning() {
+        // assets/roads: the short route starts at node 37 on Orchard Path facing 344°, away
+        // from its goal, node 10; turning round would make it 67.9 m, the route without a
+        // U-turn is 190.2 m (the generator's own Dijkstra, `generate_park.py --check`)
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/roads/park/park.osm");
+        let g = crate::world::roads::load_roads(
+            std::path::Path::new(path),
+            &crate::world::roads::RoadOptions::default(),
+        )
+        .unwrap();
+        let junctions = (0..g.nodes.len()).filter(|&n| g.degree(n) != 2).count();
+        assert!(junctions >= 30, "{junctions} junctions and road ends");
+        assert!((0..g.nodes.len()).any(|n| g.degree(n) >= 4));
+        let s = g.node_by_source("37").unwrap();
+        let goal = g.node_by_source("10").unwrap();
+        let off = |&(e, _): &(EdgeId, NodeId)| {
+            let d = g.azimuth_from(e, s).to_degrees() - 344.1;
+            (d + 180.0).rem_euclid(360.0) - 180.0
+        };
+        let (ahead, behind) = {
+            let mut at: Vec<_> = g.adjacency[s].clone();
+            at.sort_by(|x, y| off(x).abs().total_cmp(&off(y).abs()));
+            (at[0], at[1])
+        };
+        let go = |(edge, toward): (EdgeId, NodeId)| {
+            plan_route(
+                &g,
+                RoadStart {
+                    edge,
+                    toward,
+                    remaining: g.edges[edge].length,
+                },
+                goal,
+            )
+            .unwrap()
+        };
+        let forward = go(ahead);
+        assert!((forward.length - 190.2).abs() < 0.1, "{}", forward.length);
+        assert!((go(behind).length - 67.9).abs() < 0.1);
+    }
+
+    #[test]
     fn bad_queries_are_errors() {
         let g = park();
         assert!(matches!(

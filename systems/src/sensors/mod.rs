@@ -2,12 +2,16 @@
 //! a sampling system in [`SimSet::Sense`](crate::core::SimSet::Sense) that reads ground truth and
 //! writes readings shaped like the ROS messages they are recorded as.
 
+pub mod compass;
 pub mod encoder;
+pub mod gps;
 pub mod laser;
 pub mod others;
 pub mod sonar;
 
+pub use compass::{Compass, CompassReading, CompassReadings, CompassSpec};
 pub use encoder::{Encoder, EncoderReading, EncoderReadings, EncoderSpec};
+pub use gps::{Gps, GpsFix, GpsReadings, GpsSpec};
 pub use laser::{Laser, LaserScan, LaserScans, LaserSpec, LaserTruth};
 pub use sonar::{SonarReadings, SonarSpec, SonarTruth, Sonars};
 
@@ -25,6 +29,8 @@ impl SimPlugin for SensorsPlugin {
                 laser::sample_lasers,
                 sonar::sample_sonars,
                 encoder::sample_encoders,
+                gps::sample_gps,
+                compass::sample_compasses,
             )
                 .chain()
                 .in_set(SimSet::Sense),

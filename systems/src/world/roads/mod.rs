@@ -27,6 +27,10 @@ pub use graph::{EdgeId, EdgePoint, NodeId, Road, RoadEdge, RoadGraph, RoadNode};
 
 use std::path::{Path, PathBuf};
 
+/// The world's geographic frame: local metres ↔ latitude/longitude, for GPS fixes and roads.
+#[derive(bevy_ecs::prelude::Resource, Clone, Copy, Debug, PartialEq)]
+pub struct GeoFrame(pub LocalProjection);
+
 #[derive(Debug, thiserror::Error)]
 pub enum RoadError {
     #[error("{path}: cannot read: {source}")]

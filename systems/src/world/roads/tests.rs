@@ -230,3 +230,24 @@ fn widths_and_surfaces_parse_like_osm_writes_them() {
     assert_eq!(Surface::from_tag("paving_stones"), Surface::Paving);
     assert_eq!(Surface::from_tag("woodchips"), Surface::Unknown);
 }
+
+#[test]
+fn the_bundled_park_reads_the_same_from_osm_and_gpx() {
+    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/roads/park"));
+    let osm = load_roads(&dir.join("park.osm"), &RoadOptions::default()).unwrap();
+    let gpx = load_roads(&dir.join("park.gpx"), &RoadOptions::default()).unwrap();
+    // assets/roads/README.md: 179 nodes, 195 edges, 2256.6 m; the building and the wood skipped
+    for g in [&osm, &gpx] {
+        assert_eq!((g.nodes.len(), g.edges.len()), (179, 195));
+        assert!(
+            (g.total_length() - 2256.6).abs() < 0.1,
+            "{}",
+            g.total_length()
+        );
+    }
+    assert_eq!(osm.roads.len(), 20);
+    let surfaces: std::collections::HashSet<_> = osm.roads.iter().map(|r| r.surface).collect();
+    assert!(surfaces.contains(&Surface::Asphalt) && surfaces.contains(&Surface::Gravel));
+    // the same reference point, so the same local coordinates
+    assert!(haversine(osm.projection.reference, gpx.projection.reference) < 0.01);
+}
