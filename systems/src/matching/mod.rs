@@ -37,6 +37,7 @@ pub mod scan_points;
 mod error;
 mod fast_atan2;
 mod improved;
+mod judge;
 mod matcher;
 mod normals;
 mod orientation;
