@@ -99,6 +99,10 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
             sonar: None,
             localizers: Vec::new(),
             navigation: None,
+            gps: None,
+            compass: None,
+            camera: None,
+            route: None,
         });
     }
     Scenario {
@@ -116,6 +120,8 @@ pub fn swarm_scenario(grid: &OccupancyGrid, n: usize, beams: usize, duration: f6
         doors: Vec::new(),
         end_when_done: false,
         people: Vec::new(),
+        roads: None,
+        zones: Vec::new(),
     }
 }
 

@@ -86,10 +86,12 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
         world.insert_resource(LocalizationMap::new(scenario.grid.clone(), max_dist));
     }
 
+    crate::build_outdoor::insert_outdoor_world(&mut world, scenario);
     let mut robots = Vec::with_capacity(scenario.robots.len());
     for (i, r) in scenario.robots.iter().enumerate() {
         let body = physics.add_robot(i as u32, &r.start, &r.footprint);
         let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body)?;
+        crate::build_outdoor::insert_outdoor_parts(&mut world, scenario.seed, e, r);
         if let (Some(nav), Some(maps)) = (&r.navigation, &costmaps) {
             let mut params = nav.params.clone();
             params.costmap = maps.index_of(&nav.costmap).unwrap_or(0);

@@ -6,6 +6,7 @@ pub mod bench_loc;
 pub mod bench_match;
 pub mod bench_slam;
 pub mod build;
+pub mod build_outdoor;
 pub mod carmen;
 pub mod carmen_out;
 pub mod experiment;
@@ -21,6 +22,7 @@ pub mod script;
 pub mod slam_cmd;
 pub mod stats;
 pub mod summary;
+pub mod summary_road;
 
 pub use run_exports::RunExports;
 pub use runner::{RunOptions, RunOutput, run_scenario, run_scenario_exporting};

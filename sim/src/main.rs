@@ -204,6 +204,26 @@ enum BenchCommand {
 
 #[derive(Subcommand)]
 enum ExperimentCommand {
+    /// The park runs of 004_95e533f2514531b8.txt: each route N times (seeds 0..N), navigating by
+    /// road-grid localization and by road MCL; reached-goal rate, wrong turns, recoveries,
+    /// time and localization error of both localizers.
+    Park {
+        /// Runs per route and localizer.
+        #[arg(long, default_value_t = 20)]
+        runs: u64,
+        /// One JSON object per row, one per line (and one per run with --per-run).
+        #[arg(long)]
+        json: bool,
+        /// With --json: also print every run.
+        #[arg(long)]
+        per_run: bool,
+        /// Routes (bundled scenario names or paths).
+        #[arg(long, value_delimiter = ',', default_values_t = sim::experiment::park::ROUTES.map(String::from))]
+        routes: Vec<String>,
+        /// Worker threads (0 = one per core). Results do not depend on it.
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+    },
     /// The scan-matching protocol of 000_9f0113837c153763.txt on maze and hospital scans:
     /// success λ, σx, σy, σθ and time per alignment for every DE strategy, the Euclidean
     /// reference and the improved matcher.
@@ -364,6 +384,35 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
             json,
         }),
         Command::Experiment { which } => match which {
+            ExperimentCommand::Park {
+                runs,
+                json,
+                per_run,
+                routes,
+                threads,
+            } => {
+                let (rows, all) = sim::experiment::park::run_park_experiment(
+                    &sim::experiment::park::ParkOptions {
+                        routes,
+                        runs,
+                        threads,
+                        progress: !json,
+                    },
+                )?;
+                if json {
+                    for r in &rows {
+                        println!("{}", serde_json::to_string(r)?);
+                    }
+                    if per_run {
+                        for r in &all {
+                            println!("{}", serde_json::to_string(r)?);
+                        }
+                    }
+                } else {
+                    print!("{}", sim::experiment::park::table(&rows));
+                }
+                Ok(())
+            }
             ExperimentCommand::DeMatch {
                 json,
                 full,

@@ -2,6 +2,7 @@
 //! progress (simulated time and real-time factor), records, and gathers the summary.
 
 use crate::build::{SimWorld, build_world};
+use crate::record::outdoor::{OutdoorRecording, record_outdoor};
 use crate::record::slam::{SlamRecording, record_slam, record_slam_final};
 use crate::record::{RrdRecorder, record_navigation, record_rrd};
 use crate::run_exports::{Exported, RunExports};
@@ -14,13 +15,17 @@ use std::path::PathBuf;
 use std::time::Instant;
 use systems::body::TruePose;
 use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
+use systems::eval::road_metrics::RoadRunMetrics;
 use systems::eval::{
     LocalizationSamples, LocalizerMetrics, NavOutcome, RobotMetrics, Sample, TrajectoryMetrics,
     pair_with_truth,
 };
+use systems::localization::road_wiring::RoadLocalization;
 use systems::localization::{Filter, Localizers};
+use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
 use systems::navigation::{Behaviour, NavStatus, Navigator};
 use systems::sensors::{LaserScans, LaserTruth};
+use systems::world::roads::RoadMap;
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
@@ -72,6 +77,13 @@ fn tasks_all_done(w: &mut World) -> bool {
             return false;
         }
     }
+    let mut q = w.query::<&RoadNavigator>();
+    for n in q.iter(w) {
+        any = true;
+        if n.phase != RoadPhase::Arrived {
+            return false;
+        }
+    }
     any
 }
 
@@ -94,6 +106,12 @@ fn event_log(w: &mut World) -> Vec<(f64, String, String)> {
                 .iter()
                 .map(|(t, e)| (*t, id.0.clone(), e.clone())),
         );
+    }
+    let mut q = w.query::<(&RobotIndex, &RobotId, &RoadNavigator)>();
+    let mut navs: Vec<_> = q.iter(w).collect();
+    navs.sort_by_key(|(i, ..)| **i);
+    for (_, id, n) in navs {
+        log.extend(n.events.iter().map(|(t, e)| (*t, id.0.clone(), e.clone())));
     }
     // stable: same-time lines keep world events first, then robots in index order
     log.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -229,8 +247,13 @@ fn run(
             scenario.record.scan_rate,
             scenario.record.slam_rate,
         ));
+        sim.world.insert_resource(OutdoorRecording::new(
+            scenario.record.camera_rate,
+            scenario.record.rate,
+            scenario.record.particle_rate,
+        ));
         sim.schedule.add_systems(
-            (record_rrd, record_navigation, record_slam)
+            (record_rrd, record_navigation, record_slam, record_outdoor)
                 .chain()
                 .in_set(SimSet::Record),
         );
@@ -335,10 +358,12 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
         Option<&Behaviour>,
         Option<(&Localizers, &LocalizationSamples)>,
         Option<(&Navigator, &NavOutcome)>,
+        Option<(&RoadNavigator, &RoadLocalization, &RoadRunMetrics)>,
     )>();
+    let graph = w.get_resource::<RoadMap>().map(|r| r.0.clone());
     let mut rows: Vec<(RobotIndex, RobotSummary)> = q
         .iter(w)
-        .map(|(i, id, truth, m, b, loc, nav)| {
+        .map(|(i, id, truth, m, b, loc, nav, road)| {
             let localization = match loc {
                 Some((locs, samples)) => locs
                     .items
@@ -383,6 +408,9 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                     final_pose: [p.x, p.y, p.theta],
                     localization,
                     navigation: nav.map(|(n, o)| navigation_summary(n, o, m)),
+                    road: road
+                        .zip(graph.as_deref())
+                        .map(|((n, l, rm), g)| crate::summary_road::road_summary(g, n, l, rm)),
                 },
             )
         })

@@ -41,6 +41,9 @@ pub struct RobotSummary {
     /// Task-driven navigation outcomes (robots with tasks only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub navigation: Option<NavigationSummary>,
+    /// Outdoor drive on the road network (robots with a route only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub road: Option<crate::summary_road::RoadSummary>,
 }
 
 #[derive(Serialize, Clone, Debug, PartialEq)]

@@ -7,5 +7,6 @@
 //! * [`scan_pairs`] — its scan capture and pair selection (shared with `sim bench de-match`).
 
 pub mod de_match;
+pub mod park;
 pub mod scan_pairs;
 pub mod slam_compare;

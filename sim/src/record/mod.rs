@@ -3,6 +3,7 @@
 
 pub mod belief;
 pub mod navigation;
+pub mod outdoor;
 pub mod replay;
 pub mod rrd;
 pub mod slam;

@@ -74,7 +74,7 @@ struct Track {
     styled: bool,
 }
 
-fn colour(index: u32) -> rerun::Color {
+pub(super) fn colour(index: u32) -> rerun::Color {
     const PALETTE: [[u8; 3]; 8] = [
         [31, 119, 180],
         [255, 127, 14],

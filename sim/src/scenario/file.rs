@@ -28,6 +28,11 @@ pub struct ScenarioFile {
     /// Walking people (`[[people]]` tables).
     #[serde(default)]
     pub people: Vec<super::people::PersonFile>,
+    /// An outdoor road network (`[roads]`).
+    pub roads: Option<super::outdoor::RoadsFile>,
+    /// Areas that degrade GPS and compass (`[[zones]]`).
+    #[serde(default)]
+    pub zones: Vec<super::outdoor::ZoneFile>,
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -79,14 +84,18 @@ pub struct RecordFile {
     pub particle_points: Option<usize>,
     /// SLAM maps, trajectories and pose graphs per second (0: only at the end).
     pub slam_rate: Option<f64>,
+    /// Camera images per second.
+    pub camera_rate: Option<f64>,
 }
 
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct RobotFile {
     pub name: String,
-    /// [x, y, yaw] (m, m, rad) or a place name.
-    pub start: PointOrPlace,
+    /// A robot preset filling in footprint, kinematics and sensors (`thesis_car`).
+    pub preset: Option<String>,
+    /// [x, y, yaw] (m, m, rad) or a place name; a robot with a `route` starts on its road.
+    pub start: Option<PointOrPlace>,
     pub footprint: Option<FootprintFile>,
     pub kinematics: Option<KinematicsFile>,
     pub behaviour: Option<BehaviourFile>,
@@ -101,6 +110,8 @@ pub struct RobotFile {
     /// The robot's task queue (`[[robots.tasks]]`).
     #[serde(default)]
     pub tasks: Vec<TaskFile>,
+    /// Drive to a node of the road network (`[robots.route]`).
+    pub route: Option<super::outdoor_robot::RouteFile>,
 }
 
 #[derive(Deserialize, Debug, Default)]
@@ -214,6 +225,9 @@ pub struct SensorsFile {
     pub laser: Option<LaserFile>,
     pub encoder: Option<EncoderFile>,
     pub sonar: Option<super::sonar::SonarFile>,
+    pub gps: Option<super::outdoor_robot::GpsFile>,
+    pub compass: Option<super::outdoor_robot::CompassFile>,
+    pub camera: Option<super::outdoor_robot::CameraFile>,
 }
 
 #[derive(Deserialize, Debug, Default)]

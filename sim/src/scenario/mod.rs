@@ -8,6 +8,8 @@ pub mod events;
 pub mod file;
 pub mod localizers;
 pub mod navigation;
+pub mod outdoor;
+pub mod outdoor_robot;
 pub mod people;
 pub mod places;
 pub mod resolve;
@@ -52,6 +54,10 @@ pub struct Scenario {
     pub end_when_done: bool,
     /// Walking people, in file order.
     pub people: Vec<PersonConfig>,
+    /// The outdoor road network, if any.
+    pub roads: Option<outdoor::RoadsConfig>,
+    /// Zones that degrade GPS and compass, in file order (the last listed wins).
+    pub zones: Vec<systems::world::Zone>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -76,6 +82,8 @@ pub struct RecordConfig {
     pub particle_points: usize,
     /// SLAM maps, trajectories and pose graphs per second (0: only at the end of the run).
     pub slam_rate: f64,
+    /// Camera images per second (JPEG, with the recognized road drawn in).
+    pub camera_rate: f64,
 }
 
 impl Default for RecordConfig {
@@ -87,6 +95,7 @@ impl Default for RecordConfig {
             particle_rate: 2.0,
             particle_points: 1000,
             slam_rate: 0.5,
+            camera_rate: 1.0,
         }
     }
 }
@@ -106,6 +115,11 @@ pub struct RobotConfig {
     pub localizers: Vec<LocalizerConfig>,
     /// Task-driven navigation (planner, follower, task queue), if the robot has tasks.
     pub navigation: Option<NavConfig>,
+    pub gps: Option<systems::sensors::GpsSpec>,
+    pub compass: Option<systems::sensors::CompassSpec>,
+    pub camera: Option<systems::sensors::CameraSpec>,
+    /// Drive to a road node, localizing on the road network.
+    pub route: Option<outdoor_robot::RouteConfig>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -3,6 +3,7 @@
 
 use super::error::{ErrorContext, KeyPath, ScenarioError};
 use super::file::*;
+use super::outdoor_robot;
 use super::sensors::{resolve_encoder, resolve_laser};
 use super::{RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
@@ -11,7 +12,7 @@ use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};
 use systems::core::Pose2;
 use systems::navigation::BehaviourKind;
 use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
-use systems::world::{OccupancyGrid, load_map};
+use systems::world::{Cell, OccupancyGrid, load_map};
 
 pub(super) type R<T> = Result<T, ScenarioError>;
 
@@ -139,19 +140,32 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             radius,
         });
     }
+    let roads = match &f.roads {
+        Some(r) => Some(super::outdoor::resolve_roads(
+            &c,
+            &root.key("roads"),
+            r,
+            base_dir,
+        )?),
+        None => None,
+    };
+    let zones = super::outdoor::resolve_zones(&c, &root.key("zones"), &f.zones)?;
     let mut grid: OccupancyGrid = match &map.file {
         Some(file) => {
             let path = base_dir.join(file);
             load_map(&path).map_err(|e| c.cx.at(&mpath.key("file"), e.to_string()))?
         }
         None => {
-            let res = c.opt_positive(&mpath.key("resolution"), map.resolution, 0.05)?;
-            match grid_for_shapes(&shapes, res, 2.0) {
+            // outdoors the grid only carries obstacles (trees, buildings): 0.2 m cells
+            let default_res = if roads.is_some() { 0.2 } else { 0.05 };
+            let res = c.opt_positive(&mpath.key("resolution"), map.resolution, default_res)?;
+            let outdoor = roads.as_ref().map(|r| (r.graph.bounds(), r.margin));
+            match grid_for_world(&shapes, outdoor, res) {
                 Some(g) => g,
                 None => {
                     return c.err(
                         &root,
-                        "the world is empty: give `map.file` (a ROS map_server YAML) or walls, boxes or discs",
+                        "the world is empty: give `map.file` (a ROS map_server YAML), `[roads]` or walls, boxes or discs",
                     );
                 }
             }
@@ -244,6 +258,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             d.particle_rate,
         )?,
         particle_points: rec.particle_points.unwrap_or(d.particle_points),
+        camera_rate: c.opt_positive(&rp.key("camera_rate"), rec.camera_rate, d.camera_rate)?,
         slam_rate: match rec.slam_rate {
             Some(v) => c.range(&rp.key("slam_rate"), v, Some(0.0), None, false)?,
             None => d.slam_rate,
@@ -263,8 +278,42 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         if robots.iter().any(|o| o.name == r.name) {
             return c.err(&p.key("name"), format!("duplicate robot name `{}`", r.name));
         }
-        let footprint = resolve_footprint(&c, &p.key("footprint"), r.footprint.as_ref())?;
-        let start = point(&p.key("start"), &r.start)?;
+        let preset = match &r.preset {
+            Some(name) => Some(outdoor_robot::preset(name).map_or_else(
+                || {
+                    c.err(
+                        &p.key("preset"),
+                        format!(
+                            "unknown robot preset `{name}`; known: {}",
+                            outdoor_robot::PRESETS.join(", ")
+                        ),
+                    )
+                },
+                Ok,
+            )?),
+            None => None,
+        };
+        let footprint = match (&r.footprint, &preset) {
+            (None, Some(pr)) => pr.footprint.clone(),
+            (f, _) => resolve_footprint(&c, &p.key("footprint"), f.as_ref())?,
+        };
+        let (start, route) = match (&r.start, &r.route) {
+            (Some(_), Some(_)) => {
+                return c.err(
+                    &p.key("start"),
+                    "a robot with a `route` starts on its road at the route's `start`: remove `start`",
+                );
+            }
+            (Some(s), None) => (point(&p.key("start"), s)?, None),
+            (None, Some(rf)) => {
+                let (route, pose) =
+                    outdoor_robot::resolve_route(&c, &p.key("route"), rf, roads.as_ref())?;
+                (pose, Some(route))
+            }
+            (None, None) => {
+                return c.err(&p, "missing key `start` ([x, y, yaw] or a place name)");
+            }
+        };
         inside(&p.key("start"), &start)?;
         if !grid.disc_is_clear(start.x, start.y, footprint.bounding_radius()) {
             return c.err(
@@ -277,7 +326,10 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
                 ),
             );
         }
-        let kinematics = resolve_kinematics(&c, &p.key("kinematics"), r.kinematics.as_ref())?;
+        let kinematics = match (&r.kinematics, &preset) {
+            (None, Some(pr)) => pr.kinematics.clone(),
+            (k, _) => resolve_kinematics(&c, &p.key("kinematics"), k.as_ref())?,
+        };
         let bp = p.key("behaviour");
         let (behaviour, speed, tolerance) = match &r.behaviour {
             None => (BehaviourKind::Idle, 0.6, 0.4),
@@ -327,9 +379,15 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         };
         let encoder = match sensors.and_then(|s| s.encoder.as_ref()) {
             Some(e) => Some(resolve_encoder(&c, &sp.key("encoder"), e)?),
+            None => preset.as_ref().map(|pr| pr.encoder.clone()),
+        };
+        let default_sonar = super::sonar::SonarFile::default();
+        let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
+            Some(s) => Some(s),
+            None if preset.as_ref().is_some_and(|pr| pr.sonars) => Some(&default_sonar),
             None => None,
         };
-        let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
+        let sonar = match sonar {
             Some(s) => {
                 let sp = sp.key("sonar");
                 Some(super::sonar::resolve_sonar(
@@ -338,6 +396,66 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             }
             None => None,
         };
+        let gps = match (sensors.and_then(|s| s.gps.as_ref()), &preset) {
+            (Some(g), pr) => Some(outdoor_robot::resolve_gps(
+                &c,
+                &sp.key("gps"),
+                g,
+                pr.as_ref().map(|pr| pr.gps.clone()).unwrap_or_default(),
+            )?),
+            (None, pr) => pr.as_ref().map(|pr| pr.gps.clone()),
+        };
+        let compass = match (sensors.and_then(|s| s.compass.as_ref()), &preset) {
+            (Some(g), pr) => Some(outdoor_robot::resolve_compass(
+                &c,
+                &sp.key("compass"),
+                g,
+                pr.as_ref().map(|pr| pr.compass.clone()).unwrap_or_default(),
+            )?),
+            (None, pr) => pr.as_ref().map(|pr| pr.compass.clone()),
+        };
+        let camera = match (sensors.and_then(|s| s.camera.as_ref()), &preset) {
+            (Some(g), pr) => Some(outdoor_robot::resolve_camera(
+                &c,
+                &sp.key("camera"),
+                g,
+                pr.as_ref().map(|pr| pr.camera.clone()).unwrap_or_default(),
+            )?),
+            (None, pr) => pr.as_ref().map(|pr| pr.camera.clone()),
+        };
+        if let Some(route) = &route {
+            let missing: Vec<&str> = [
+                ("encoder", encoder.is_none()),
+                ("gps", gps.is_none()),
+                ("compass", compass.is_none()),
+                ("camera", camera.is_none()),
+            ]
+            .into_iter()
+            .filter_map(|(n, m)| m.then_some(n))
+            .collect();
+            if !missing.is_empty() {
+                return c.err(
+                    &p.key("route"),
+                    format!(
+                        "a robot with a route localizes by encoder, GPS and compass and follows the road by camera: give it {} (or `preset = \"thesis_car\"`)",
+                        missing
+                            .iter()
+                            .map(|m| format!("`[robots.sensors.{m}]`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                );
+            }
+            if r.behaviour.is_some() || !r.tasks.is_empty() {
+                return c.err(
+                    &p.key("route"),
+                    "a robot with a route is driven by its road navigator: remove `behaviour` and `tasks`",
+                );
+            }
+            if route.start == route.goal {
+                return c.err(&p.key("route").key("goal"), "the goal is the start node");
+            }
+        }
         let lp = p.key("localization");
         let localizers = super::localizers::resolve_localizers(
             &c,
@@ -429,6 +547,10 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             sonar,
             localizers,
             navigation,
+            gps,
+            compass,
+            camera,
+            route,
         });
     }
 
@@ -464,6 +586,8 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         doors,
         end_when_done: f.end_when_done.unwrap_or(false),
         people,
+        roads,
+        zones,
     })
 }
 
@@ -552,6 +676,36 @@ fn resolve_kinematics(c: &Checker, p: &KeyPath, k: Option<&KinematicsFile>) -> R
             }))
         }
     }
+}
+
+/// The grid of a world without a map file: over the shapes (2 m around them) and the road
+/// network (its margin around the roads), or `None` when there is neither.
+fn grid_for_world(
+    shapes: &[Shape],
+    roads: Option<([f64; 4], f64)>,
+    resolution: f64,
+) -> Option<OccupancyGrid> {
+    let from_shapes = grid_for_shapes(shapes, resolution, 2.0).map(|g| g.bounds());
+    let from_roads = roads.map(|(b, m)| [b[0] - m, b[1] - m, b[2] + m, b[3] + m]);
+    let b = match (from_shapes, from_roads) {
+        (Some(a), Some(b)) => [
+            a[0].min(b[0]),
+            a[1].min(b[1]),
+            a[2].max(b[2]),
+            a[3].max(b[3]),
+        ],
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => return None,
+    };
+    let w = ((b[2] - b[0]) / resolution).ceil().max(1.0) as usize;
+    let h = ((b[3] - b[1]) / resolution).ceil().max(1.0) as usize;
+    Some(OccupancyGrid::new(
+        w,
+        h,
+        resolution,
+        [b[0], b[1]],
+        Cell::Free,
+    ))
 }
 
 /// A hospital delivery robot: 0.45 m wheel base, 10 cm wheels, 1.5 m/s, 2 m/s².

@@ -3,6 +3,7 @@
 
 pub mod localization_metrics;
 pub mod navigation_metrics;
+pub mod road_metrics;
 pub mod robot_metrics;
 pub mod trajectory;
 
@@ -24,6 +25,7 @@ impl SimPlugin for EvalPlugin {
             (
                 robot_metrics::accumulate_metrics,
                 localization_metrics::sample_localization,
+                road_metrics::evaluate_road_runs,
                 navigation_metrics::evaluate_navigation.after(robot_metrics::accumulate_metrics),
             )
                 .in_set(SimSet::Evaluate),

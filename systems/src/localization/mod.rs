@@ -15,6 +15,8 @@ pub mod mcl;
 pub mod motion_model;
 pub mod nav_source;
 pub mod odometry;
+pub mod road;
+pub mod road_wiring;
 pub mod scan_estimator;
 
 #[cfg(test)]
@@ -29,6 +31,7 @@ pub use mcl::{Mcl, MclConfig, PoseEstimate};
 pub use motion_model::OdometryMotionModel;
 pub use nav_source::NavSource;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};
+pub use road::{RoadGrid, RoadLocalizer, RoadMcl, RoadObservation, RoadPosition};
 pub use scan_estimator::{GraphEdgeKind, GraphEdgeView, GraphView, ScanEstimator};
 
 use crate::core::{SimPlugin, SimSet};
@@ -41,6 +44,7 @@ impl SimPlugin for LocalizationPlugin {
         schedule.add_systems(
             (
                 odometry::integrate_odometry,
+                road_wiring::run_road_localizers,
                 localizer::run_localizers,
                 nav_source::fuse_nav_belief,
             )

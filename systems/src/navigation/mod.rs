@@ -24,7 +24,10 @@ pub mod local_map;
 pub mod navigator;
 pub mod open_list;
 pub mod outcomes;
+pub mod road_drive;
+pub mod road_follow;
 pub mod road_planner;
+pub mod road_recognition;
 pub mod shared_costmaps;
 pub mod shortcut;
 pub mod tasks;
@@ -36,6 +39,10 @@ pub use fleet::Fleet;
 pub use follower::{FollowerParams, Steering};
 pub use navigator::{NavParams, Navigator, Phase};
 pub use outcomes::{LegEvent, NavEvent, NavFailure, NavMetrics};
+pub use road_follow::{Keep, RoadCommand, RoadFollowParams, road_steering};
+pub use road_recognition::{
+    RecognitionConfig, RoadDetection, RoadDetector, RoadRecognizer, RoadRow, detect_roads,
+};
 pub use shared_costmaps::NavCostmaps;
 pub use tasks::{Goal, Step, Task, TaskKind};
 
@@ -48,12 +55,22 @@ impl SimPlugin for NavigationPlugin {
     fn build(&self, world: &mut World, schedule: &mut Schedule) {
         world.init_resource::<Fleet>();
         schedule.add_systems(
-            (shared_costmaps::sync_costmaps, drive::plan_routes)
+            (
+                shared_costmaps::sync_costmaps,
+                drive::plan_routes,
+                // the camera image of the previous tick's Sense set
+                road_recognition::detect_roads,
+            )
                 .chain()
                 .in_set(SimSet::Plan),
         );
         schedule.add_systems(
-            (behaviour::drive_behaviours, drive::drive_navigators).in_set(SimSet::Control),
+            (
+                behaviour::drive_behaviours,
+                drive::drive_navigators,
+                road_drive::system::drive_road_navigators,
+            )
+                .in_set(SimSet::Control),
         );
     }
 }

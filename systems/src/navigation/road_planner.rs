@@ -16,13 +16,7 @@ use crate::world::roads::{EdgeId, NodeId, RoadGraph};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// Where the robot is: on `edge`, driving towards its end `toward`, `remaining` metres before it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoadStart {
-    pub edge: EdgeId,
-    pub toward: NodeId,
-    pub remaining: f64,
-}
+pub use crate::world::roads::RoadStart;
 
 /// A planned route.
 #[derive(Clone, Debug, PartialEq)]

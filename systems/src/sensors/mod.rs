@@ -2,6 +2,7 @@
 //! a sampling system in [`SimSet::Sense`](crate::core::SimSet::Sense) that reads ground truth and
 //! writes readings shaped like the ROS messages they are recorded as.
 
+pub mod camera;
 pub mod compass;
 pub mod encoder;
 pub mod gps;
@@ -9,6 +10,7 @@ pub mod laser;
 pub mod others;
 pub mod sonar;
 
+pub use camera::{Camera, CameraImage, CameraImages, CameraSpec};
 pub use compass::{Compass, CompassReading, CompassReadings, CompassSpec};
 pub use encoder::{Encoder, EncoderReading, EncoderReadings, EncoderSpec};
 pub use gps::{Gps, GpsFix, GpsReadings, GpsSpec};
@@ -31,6 +33,7 @@ impl SimPlugin for SensorsPlugin {
                 encoder::sample_encoders,
                 gps::sample_gps,
                 compass::sample_compasses,
+                camera::sample_cameras,
             )
                 .chain()
                 .in_set(SimSet::Sense),

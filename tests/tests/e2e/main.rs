@@ -9,6 +9,8 @@ mod determinism;
 mod events;
 mod localization;
 mod navigation;
+mod park;
+mod park_scenarios;
 mod people;
 mod physics;
 mod recording;

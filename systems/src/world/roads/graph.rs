@@ -56,6 +56,14 @@ pub struct EdgePoint {
     pub distance: f64,
 }
 
+/// Where the robot is: on `edge`, driving towards its end `toward`, `remaining` metres before it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoadStart {
+    pub edge: EdgeId,
+    pub toward: NodeId,
+    pub remaining: f64,
+}
+
 /// A road network in local metres around its reference point.
 #[derive(Clone, Debug)]
 pub struct RoadGraph {

@@ -21,11 +21,18 @@ pub mod geo;
 mod gpx;
 pub mod graph;
 mod osm;
+pub mod surface_raster;
 
 pub use geo::{GeoPoint, LocalProjection, haversine};
-pub use graph::{EdgeId, EdgePoint, NodeId, Road, RoadEdge, RoadGraph, RoadNode};
+pub use graph::{EdgeId, EdgePoint, NodeId, Road, RoadEdge, RoadGraph, RoadNode, RoadStart};
+pub use surface_raster::{RoadSurface, SurfaceRaster};
 
 use std::path::{Path, PathBuf};
+
+/// The world's road network, shared by the planner, the road localizers, the camera's road
+/// surface and evaluation.
+#[derive(bevy_ecs::prelude::Resource, Clone, Debug)]
+pub struct RoadMap(pub std::sync::Arc<RoadGraph>);
 
 /// The world's geographic frame: local metres ↔ latitude/longitude, for GPS fixes and roads.
 #[derive(bevy_ecs::prelude::Resource, Clone, Copy, Debug, PartialEq)]
