@@ -332,3 +332,80 @@ pub(super) fn resolve_route(
     let pose = Pose2::new(a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, yaw);
     Ok((route, pose))
 }
+
+/// The robot's GPS, compass and camera (its tables over the preset's), and the checks a route
+/// needs: the sensors it drives by, no behaviour or tasks, a goal other than the start.
+#[allow(clippy::type_complexity)]
+pub(super) fn resolve_outdoor_sensors(
+    c: &Checker,
+    p: &KeyPath,
+    r: &super::file::RobotFile,
+    preset: Option<&Preset>,
+    route: Option<&RouteConfig>,
+    has_encoder: bool,
+) -> R<(Option<GpsSpec>, Option<CompassSpec>, Option<CameraSpec>)> {
+    let sensors = r.sensors.as_ref();
+    let sp = p.key("sensors");
+    let gps = over_preset(
+        sensors.and_then(|s| s.gps.as_ref()),
+        preset.map(|pr| pr.gps.clone()),
+        |f, base| resolve_gps(c, &sp.key("gps"), f, base),
+    )?;
+    let compass = over_preset(
+        sensors.and_then(|s| s.compass.as_ref()),
+        preset.map(|pr| pr.compass.clone()),
+        |f, base| resolve_compass(c, &sp.key("compass"), f, base),
+    )?;
+    let camera = over_preset(
+        sensors.and_then(|s| s.camera.as_ref()),
+        preset.map(|pr| pr.camera.clone()),
+        |f, base| resolve_camera(c, &sp.key("camera"), f, base),
+    )?;
+    if let Some(route) = route {
+        let missing: Vec<&str> = [
+            ("encoder", !has_encoder),
+            ("gps", gps.is_none()),
+            ("compass", compass.is_none()),
+            ("camera", camera.is_none()),
+        ]
+        .into_iter()
+        .filter_map(|(n, m)| m.then_some(n))
+        .collect();
+        if !missing.is_empty() {
+            return c.err(
+                &p.key("route"),
+                format!(
+                    "a robot with a route localizes by encoder, GPS and compass and follows the road by camera: give it {} (or `preset = \"thesis_car\"`)",
+                    missing
+                        .iter()
+                        .map(|m| format!("`[robots.sensors.{m}]`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            );
+        }
+        if r.behaviour.is_some() || !r.tasks.is_empty() {
+            return c.err(
+                &p.key("route"),
+                "a robot with a route is driven by its road navigator: remove `behaviour` and `tasks`",
+            );
+        }
+        if route.start == route.goal {
+            return c.err(&p.key("route").key("goal"), "the goal is the start node");
+        }
+    }
+    Ok((gps, compass, camera))
+}
+
+/// A sensor from its table over the preset's spec (or the default), the preset's without a table,
+/// none without either.
+fn over_preset<F, T: Default>(
+    file: Option<&F>,
+    preset: Option<T>,
+    resolve: impl Fn(&F, T) -> R<T>,
+) -> R<Option<T>> {
+    match file {
+        Some(f) => Ok(Some(resolve(f, preset.unwrap_or_default())?)),
+        None => Ok(preset),
+    }
+}

@@ -396,66 +396,14 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             }
             None => None,
         };
-        let gps = match (sensors.and_then(|s| s.gps.as_ref()), &preset) {
-            (Some(g), pr) => Some(outdoor_robot::resolve_gps(
-                &c,
-                &sp.key("gps"),
-                g,
-                pr.as_ref().map(|pr| pr.gps.clone()).unwrap_or_default(),
-            )?),
-            (None, pr) => pr.as_ref().map(|pr| pr.gps.clone()),
-        };
-        let compass = match (sensors.and_then(|s| s.compass.as_ref()), &preset) {
-            (Some(g), pr) => Some(outdoor_robot::resolve_compass(
-                &c,
-                &sp.key("compass"),
-                g,
-                pr.as_ref().map(|pr| pr.compass.clone()).unwrap_or_default(),
-            )?),
-            (None, pr) => pr.as_ref().map(|pr| pr.compass.clone()),
-        };
-        let camera = match (sensors.and_then(|s| s.camera.as_ref()), &preset) {
-            (Some(g), pr) => Some(outdoor_robot::resolve_camera(
-                &c,
-                &sp.key("camera"),
-                g,
-                pr.as_ref().map(|pr| pr.camera.clone()).unwrap_or_default(),
-            )?),
-            (None, pr) => pr.as_ref().map(|pr| pr.camera.clone()),
-        };
-        if let Some(route) = &route {
-            let missing: Vec<&str> = [
-                ("encoder", encoder.is_none()),
-                ("gps", gps.is_none()),
-                ("compass", compass.is_none()),
-                ("camera", camera.is_none()),
-            ]
-            .into_iter()
-            .filter_map(|(n, m)| m.then_some(n))
-            .collect();
-            if !missing.is_empty() {
-                return c.err(
-                    &p.key("route"),
-                    format!(
-                        "a robot with a route localizes by encoder, GPS and compass and follows the road by camera: give it {} (or `preset = \"thesis_car\"`)",
-                        missing
-                            .iter()
-                            .map(|m| format!("`[robots.sensors.{m}]`"))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
-                );
-            }
-            if r.behaviour.is_some() || !r.tasks.is_empty() {
-                return c.err(
-                    &p.key("route"),
-                    "a robot with a route is driven by its road navigator: remove `behaviour` and `tasks`",
-                );
-            }
-            if route.start == route.goal {
-                return c.err(&p.key("route").key("goal"), "the goal is the start node");
-            }
-        }
+        let (gps, compass, camera) = outdoor_robot::resolve_outdoor_sensors(
+            &c,
+            &p,
+            r,
+            preset.as_ref(),
+            route.as_ref(),
+            encoder.is_some(),
+        )?;
         let lp = p.key("localization");
         let localizers = super::localizers::resolve_localizers(
             &c,

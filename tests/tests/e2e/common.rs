@@ -18,6 +18,18 @@ pub fn scenario_error(text: &str) -> String {
     }
 }
 
+/// The scenario is rejected with an error at `line` of test.toml containing every fragment.
+pub fn expect_error(text: &str, line: usize, fragments: &[&str]) {
+    let e = scenario_error(text);
+    assert!(
+        e.starts_with(&format!("test.toml:{line}:")),
+        "expected line {line} in: {e}"
+    );
+    for f in fragments {
+        assert!(e.contains(f), "expected `{f}` in: {e}");
+    }
+}
+
 pub fn world(text: &str) -> SimWorld {
     build_world(&scenario(text), 1).expect("world builds")
 }

@@ -16,16 +16,9 @@ fn line_of(text: &str, prefix: &str) -> usize {
     text.lines().position(|l| l.starts_with(prefix)).unwrap() + 1
 }
 
+/// The error is at the first line starting with `prefix`.
 fn expect_at(text: &str, prefix: &str, fragments: &[&str]) {
-    let e = scenario_error(text);
-    let line = line_of(text, prefix);
-    assert!(
-        e.starts_with(&format!("test.toml:{line}:")),
-        "expected line {line} in: {e}"
-    );
-    for f in fragments {
-        assert!(e.contains(f), "expected `{f}` in: {e}");
-    }
+    expect_error(text, line_of(text, prefix), fragments);
 }
 
 #[test]

@@ -27,18 +27,6 @@ fn with_robot(robot: &str) -> String {
     format!("{SQUARE_ROOM}\n[[robots]]\nname = \"r1\"\nstart = [5.0, 5.0, 0.0]\n{robot}\n")
 }
 
-/// (line, expected fragments) of an error.
-fn expect_error(text: &str, line: usize, fragments: &[&str]) {
-    let e = scenario_error(text);
-    assert!(
-        e.starts_with(&format!("test.toml:{line}:")),
-        "expected line {line} in: {e}"
-    );
-    for f in fragments {
-        assert!(e.contains(f), "expected `{f}` in: {e}");
-    }
-}
-
 #[test]
 fn unknown_top_level_key() {
     expect_error("duration = 1.0\ncolour = \"red\"\n", 2, &["colour"]);
