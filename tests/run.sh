@@ -2,8 +2,9 @@
 # Runs every test of the workspace, in release mode.
 #
 # The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
-# the Python SDK's RrdReader); this script installs rerun-sdk==0.36.3 from PyPI into a virtual
-# environment once (under $SIM_CACHE, default ~/.cache/sim) and points the tests at it.
+# the Python SDK's RrdReader) and Foxglove's Python MCAP readers (mcap, mcap-ros2-support); this
+# script installs them from PyPI into a virtual environment once (under $SIM_CACHE, default
+# ~/.cache/sim) and points the tests at it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,6 +17,12 @@ if ! "$venv/bin/rerun" --version 2>/dev/null | grep -q "0.36.3"; then
     python3 -m venv "$venv"
     "$venv/bin/pip" install --quiet --disable-pip-version-check "rerun-sdk==0.36.3"
     "$venv/bin/rerun" analytics disable >/dev/null 2>&1 || true
+fi
+# Foxglove's Python MCAP readers, for the ROS 2 replay checks (tests/check_mcap.py)
+if ! "$venv/bin/python" -c "from importlib.metadata import version as v
+assert (v('mcap'), v('mcap-ros2-support')) == ('1.6.0', '0.6.0')" 2>/dev/null; then
+    "$venv/bin/pip" install --quiet --disable-pip-version-check \
+        "mcap==1.6.0" "mcap-ros2-support==0.6.0"
 fi
 export SIM_RERUN_VENV="$venv"
 

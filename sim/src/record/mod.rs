@@ -1,7 +1,9 @@
-//! Recording: the Rerun .rrd file (always, unless disabled) and, on request, TUM trajectories of
-//! every localizer. MCAP replays come later.
+//! Recording: the Rerun .rrd file (always, unless disabled), on request TUM trajectories of
+//! every localizer, and the MCAP layer of ROS 2 replays ([`mcap`]: messages, schemas, CDR,
+//! writer and reader; not yet wired to the runner).
 
 pub mod belief;
+pub mod mcap;
 pub mod navigation;
 pub mod outdoor;
 pub mod replay;

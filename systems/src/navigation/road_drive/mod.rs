@@ -17,6 +17,9 @@ use crate::world::roads::geo::heading_of_azimuth;
 use crate::world::roads::{EdgeId, NodeId, RoadGraph, Surface};
 use bevy_ecs::prelude::Component;
 
+/// A heading within this angle (rad) of the way back along the edge counts as turned round.
+const TURNED_ROUND: f64 = 0.7;
+
 /// Which part of the road the camera follower aims at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FollowSide {
@@ -45,10 +48,15 @@ pub struct RoadNavParams {
     pub max_curvature: f64,
     /// Look-ahead of the map pursuit along the route (m).
     pub lookahead: f64,
-    /// The camera's target is followed when it lies within this angle (rad) of the map's, in
-    /// junctions and between them.
+    /// In a junction the camera's target is followed when it lies within this angle (rad) of
+    /// the map's.
     pub junction_agreement: f64,
+    /// Between junctions it is followed when it lies within this angle (rad) of the map's and
+    /// within the road's half width plus this margin (m) of the map's line…
     pub road_agreement: f64,
+    pub road_margin: f64,
+    /// …plus this much (m per m ahead) for the heading error.
+    pub heading_slack: f64,
 }
 
 impl Default for RoadNavParams {
@@ -64,7 +72,9 @@ impl Default for RoadNavParams {
             max_curvature: 1.2,
             lookahead: 2.5,
             junction_agreement: 0.4,
-            road_agreement: 0.8,
+            road_agreement: 1.0,
+            road_margin: 2.5,
+            heading_slack: 0.2,
         }
     }
 }
@@ -300,7 +310,7 @@ impl RoadNavigator {
         if let RoadPhase::TurningRound { azimuth } = self.phase {
             let done = input
                 .compass
-                .is_none_or(|c| wrap_angle(azimuth - c).abs() < 0.35);
+                .is_none_or(|c| wrap_angle(azimuth - c).abs() < 0.5 * TURNED_ROUND);
             if !done {
                 let v = p.speed * p.slow_factor * 0.5;
                 // turn the shorter way round: azimuth clockwise, yaw anticlockwise
@@ -325,8 +335,19 @@ impl RoadNavigator {
         }
         let step = self.check_route(graph, input.now, b);
         if step.is_none() && self.failed_from == Some((b.edge, b.toward)) && b.remaining < 2.0 {
-            // a dead end ahead and no way on without turning: turn round
             let back = graph.azimuth_from(b.edge, b.toward);
+            if input
+                .compass
+                .is_some_and(|c| wrap_angle(back - c).abs() < TURNED_ROUND)
+            {
+                // the compass says the robot already faces back along the edge: the belief's
+                // direction is wrong, so drive on by camera until the localization (which
+                // drops estimates the compass contradicts) has it right
+                let v = p.speed * p.slow_factor;
+                let k = (input.follow)(FollowSide::Centre).map_or(0.0, pursuit_curvature);
+                return self.drive(&p, input, v, k);
+            }
+            // a dead end ahead and no way on without turning: turn round
             self.events
                 .push((input.now, "turning round at a dead end".into()));
             self.phase = RoadPhase::TurningRound { azimuth: back };
@@ -393,13 +414,19 @@ impl RoadNavigator {
         let map = input.compass.map(|c| self.map_pursuit(graph, b, step, c));
         // the camera leads where it sees the road the map says the route takes; where it
         // does not (a crossing road of another surface, a junction's open area) the map leads
-        let limit = if slow {
-            p.junction_agreement
-        } else {
-            p.road_agreement
+        let half_width = 0.5 * graph.roads[graph.edges[b.edge].road].width;
+        let agrees = |c: [f64; 2], m: [f64; 2]| {
+            if slow {
+                angle_between(c, m) <= p.junction_agreement
+            } else {
+                // the belief has no lateral position: the camera's road may lie anywhere
+                // within the road's width of the map's line, give or take a heading error
+                angle_between(c, m) <= p.road_agreement
+                    && lateral_gap(c, m) <= half_width + p.road_margin + p.heading_slack * c[0]
+            }
         };
         let target = match (camera, map) {
-            (Some(c), Some(m)) if angle_between(c, m) <= limit => Some(c),
+            (Some(c), Some(m)) if agrees(c, m) => Some(c),
             (Some(c), None) => Some(c),
             (_, m) => m,
         };
@@ -419,6 +446,12 @@ impl RoadNavigator {
 /// Pure-pursuit curvature (1/m, left positive) to a point in the robot frame.
 fn pursuit_curvature(t: [f64; 2]) -> f64 {
     2.0 * t[1] / (t[0] * t[0] + t[1] * t[1]).max(1e-6)
+}
+
+/// How far (m) the point `c` lies to the side of the line from the robot through `m`.
+fn lateral_gap(c: [f64; 2], m: [f64; 2]) -> f64 {
+    let len = m[0].hypot(m[1]).max(1e-9);
+    ((m[0] * c[1] - m[1] * c[0]) / len).abs()
 }
 
 /// Angle (rad) between two directions from the robot.

@@ -79,6 +79,10 @@ fn the_map_leads_where_the_camera_disagrees_with_the_route() {
     let left = |_: FollowSide| Some([1.0, 3.0]);
     let (_, w) = nav.step(g, &input(0.1, Some(b), Some(az), &left));
     assert!(w.abs() < 0.05, "followed the camera off the route: ω = {w}");
+    // the road 3 m to the right, 5 m ahead (the robot has drifted off it): the camera leads
+    let right = |_: FollowSide| Some([5.0, -3.0]);
+    let (_, w) = nav.step(g, &input(0.2, Some(b), Some(az), &right));
+    assert!(w < -0.1, "did not steer back to the road: ω = {w}");
 }
 
 #[test]

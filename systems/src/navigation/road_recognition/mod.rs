@@ -25,6 +25,11 @@ use crate::sensors::camera::{CameraImage, CameraImages};
 use bevy_ecs::prelude::*;
 pub use colour_table::ColourTable;
 
+/// At most this many background colours are kept.
+const BACKGROUND_COLOURS: usize = 32;
+/// Frames a relearning looks for the new road in.
+const RELEARN_BUDGET: u32 = 50;
+
 /// Where each row's scan starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ScanStart {
@@ -53,6 +58,9 @@ pub struct RecognitionConfig {
     /// A row's scan ends after more than this many consecutive non-road samples.
     pub max_misses: u32,
     pub scan_from: ScanStart,
+    /// The road's lowest row is looked for in this bottom fraction of the image (with
+    /// `PreviousCentre`; the thesis's rule ends at the first row without road).
+    pub search_fraction: f64,
 }
 
 impl Default for RecognitionConfig {
@@ -67,6 +75,7 @@ impl Default for RecognitionConfig {
             row_step: 2,
             max_misses: 2,
             scan_from: ScanStart::PreviousCentre,
+            search_fraction: 0.75,
         }
     }
 }
@@ -104,7 +113,12 @@ pub struct RoadDetection {
 pub struct RoadRecognizer {
     pub config: RecognitionConfig,
     pub table: ColourTable,
+    /// Colours seen beside the recognized road (grass, verge): never learned as road.
+    pub background: ColourTable,
     frames_learned: u32,
+    /// Frames still to learn a new surface from, and frames left to find them in.
+    relearn_frames: u32,
+    relearn_budget: u32,
 }
 
 /// One half-row scan: the nearest and the farthest road sample, and whether it ended at the
@@ -119,8 +133,11 @@ impl RoadRecognizer {
     pub fn new(config: RecognitionConfig) -> Self {
         RoadRecognizer {
             table: ColourTable::new(config.threshold as f32, config.max_colours),
+            background: ColourTable::new(config.threshold as f32, BACKGROUND_COLOURS),
             config,
             frames_learned: 0,
+            relearn_frames: 0,
+            relearn_budget: 0,
         }
     }
 
@@ -131,28 +148,89 @@ impl RoadRecognizer {
 
     /// Learns the colours in the learning window; returns how many were new.
     pub fn learn(&mut self, image: &CameraImage) -> usize {
+        let pixels: Vec<[u8; 3]> = self.window_pixels(image).collect();
+        let added = pixels
+            .into_iter()
+            .map(|p| usize::from(self.table.learn(p)))
+            .sum();
+        self.frames_learned += 1;
+        added
+    }
+
+    /// Learns a road of another surface from the next `frames` frames whose learning window
+    /// shows a road (mostly colours that are not background), looking for them over
+    /// at most [`RELEARN_BUDGET`] frames. The road already learned stays recognized meanwhile.
+    pub fn relearn(&mut self, frames: u32) {
+        self.relearn_frames = frames;
+        self.relearn_budget = RELEARN_BUDGET;
+    }
+
+    /// Whether a relearning asked for is still looking for the new road.
+    pub fn relearning(&self) -> bool {
+        self.relearn_frames > 0 && self.relearn_budget > 0
+    }
+
+    /// The learning window's pixels (row-major, `learn_step` apart).
+    fn window_pixels(&self, image: &CameraImage) -> impl Iterator<Item = [u8; 3]> {
         let (w, h) = (image.width as f64, image.height as f64);
         let [l, t, r, b] = self.config.window;
         let col = |f: f64, n: f64| ((f * n).round() as u32).min(n as u32);
         let (u0, u1) = (col(l, w), col(r, w));
         let (v0, v1) = (col(t, h), col(b, h));
         let step = self.config.learn_step.max(1) as usize;
-        let mut added = 0;
-        for v in (v0..v1).step_by(step) {
-            for u in (u0..u1).step_by(step) {
-                added += usize::from(self.table.learn(image.pixel(u, v)));
-            }
-        }
-        self.frames_learned += 1;
-        added
+        (v0..v1)
+            .step_by(step)
+            .flat_map(move |v| (u0..u1).step_by(step).map(move |u| image.pixel(u, v)))
     }
 
-    /// Learns again from the next `frames` frames (a road of another surface: the road follower
-    /// has the robot on it, so the learning window sees it).
-    pub fn relearn(&mut self, frames: u32) {
-        self.frames_learned = self
-            .frames_learned
-            .min(self.config.learn_frames.saturating_sub(frames));
+    /// One frame of relearning: learns the window's colours that are not background when
+    /// most of them are not (the robot is on a road), else waits for a better frame.
+    fn relearn_from(&mut self, image: &CameraImage) {
+        self.relearn_budget -= 1;
+        let pixels: Vec<[u8; 3]> = self.window_pixels(image).collect();
+        let clear = pixels
+            .iter()
+            .filter(|&&p| !self.background.is_road(p))
+            .count();
+        if 2 * clear < pixels.len() {
+            return;
+        }
+        for p in pixels {
+            if !self.background.is_road(p) {
+                self.table.learn(p);
+            }
+        }
+        self.relearn_frames -= 1;
+    }
+
+    /// Learns colours beside a road recognized with both edges in the near rows: the
+    /// background a new road must differ from.
+    fn learn_background(&mut self, image: &CameraImage, det: &RoadDetection) {
+        if self.background.learned().len() >= BACKGROUND_COLOURS {
+            return;
+        }
+        let w = image.width as f64;
+        let gap = 2.0 * self.config.pixel_step as f64;
+        for row in det
+            .rows
+            .iter()
+            .filter(|r| r.left_edge && r.right_edge)
+            .take(8)
+        {
+            for u in [
+                row.left - gap,
+                row.left - 3.0 * gap,
+                row.right + gap,
+                row.right + 3.0 * gap,
+            ] {
+                if (0.0..w).contains(&u) {
+                    let p = image.pixel(u as u32, row.v);
+                    if !self.table.is_road(p) {
+                        self.background.learn(p);
+                    }
+                }
+            }
+        }
     }
 
     /// Learns from the frame while learning, then finds the road in it.
@@ -160,8 +238,13 @@ impl RoadRecognizer {
         let learning = self.learning();
         if learning {
             self.learn(image);
+        } else if self.relearning() {
+            self.relearn_from(image);
         }
         let mut det = self.recognize(image);
+        if !learning {
+            self.learn_background(image, &det);
+        }
         det.learning = learning;
         det
     }
@@ -174,8 +257,20 @@ impl RoadRecognizer {
         let mut rows = Vec::new();
         let mut start = w / 2;
         let mut v = h - 1;
+        // rows without road below the first row with road are skipped (the robot beside the
+        // road sees it further up, off to one side); after that the road ends at the first
+        // row without it
+        let lowest = if c.scan_from == ScanStart::PreviousCentre {
+            (h as f64 * (1.0 - c.search_fraction)) as i64
+        } else {
+            h
+        };
         while v >= 0 {
             let Some(row) = self.scan_row(image, v as u32, start.clamp(0, w - 1), step) else {
+                if rows.is_empty() && v > lowest {
+                    v -= c.row_step.max(1) as i64;
+                    continue;
+                }
                 break;
             };
             if c.scan_from == ScanStart::PreviousCentre {
@@ -193,7 +288,18 @@ impl RoadRecognizer {
         }
     }
 
-    fn scan_side(&self, image: &CameraImage, v: u32, start: i64, dir: i64, step: i64) -> Side {
+    /// Scans one half-row outwards from `start`. With `seek` (the start is off the road) the
+    /// misses before the first road sample do not count: the scan looks for the nearest road
+    /// across the whole half-row.
+    fn scan_side(
+        &self,
+        image: &CameraImage,
+        v: u32,
+        start: i64,
+        dir: i64,
+        step: i64,
+        seek: bool,
+    ) -> Side {
         let w = image.width as i64;
         let mut side = Side {
             first: None,
@@ -211,7 +317,7 @@ impl RoadRecognizer {
                 side.first.get_or_insert(c);
                 side.last = Some(c);
                 misses = 0;
-            } else {
+            } else if !(seek && side.first.is_none()) {
                 misses += 1;
                 if misses > self.config.max_misses {
                     return side;
@@ -225,9 +331,11 @@ impl RoadRecognizer {
     fn scan_row(&self, image: &CameraImage, v: u32, start: i64, step: i64) -> Option<RoadRow> {
         let w = image.width as f64;
         let half = 0.5 * step as f64;
-        let left = self.scan_side(image, v, start, -1, step);
-        let right = self.scan_side(image, v, start, 1, step);
         let on_road = self.table.is_road(image.pixel(start as u32, v));
+        // the thesis gives up on a row whose start is off the road; we look along it
+        let seek = !on_road && self.config.scan_from == ScanStart::PreviousCentre;
+        let left = self.scan_side(image, v, start, -1, step, seek);
+        let right = self.scan_side(image, v, start, 1, step, seek);
         // the extent of road samples, and whether each end is open (image border)
         let (lo, lo_open, hi, hi_open) = if on_road {
             (

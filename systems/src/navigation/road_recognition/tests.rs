@@ -201,3 +201,83 @@ fn the_system_detects_on_fresh_images_only() {
     assert!(!det.learning && det.rows.len() > 40, "{}", det.rows.len());
     assert!((det.stamp - 0.7).abs() < 1e-9, "{}", det.stamp);
 }
+
+#[test]
+fn a_robot_beside_the_road_still_finds_it_further_up_the_image() {
+    // 2 m beyond the left edge of the 4 m asphalt avenue, parallel to it
+    let (rec, mut cam, _) = learned_at(park_pose("82", "15", 3.0, 0.0), 5);
+    let img = cam.shoot(0.0, park_pose("82", "15", 8.0, 4.0), &park_fixture().1);
+    let det = rec.recognize(&img);
+    assert!(det.rows.len() >= 5, "{} rows", det.rows.len());
+    // the bottom rows see grass only; the road appears higher up, right of the centre
+    let first = det.rows[0];
+    assert!(first.v < 235, "{first:?}");
+    assert!(first.centre > 200.0, "{first:?}");
+    let spec = CameraSpec::default();
+    let g = spec
+        .ground_point(first.centre, first.v as f64 + 0.5)
+        .unwrap();
+    assert!(
+        (-5.5..=-1.8).contains(&g[1]),
+        "road centre at {g:?} (robot frame)"
+    );
+}
+
+#[test]
+fn relearning_waits_for_the_new_road_and_never_learns_grass() {
+    let raster = &park_fixture().1;
+    let (mut rec, mut cam, _) = learned_at(park_pose("82", "15", 3.0, 0.0), 6);
+    // driving on asphalt teaches the background beside it
+    for i in 0..10 {
+        let img = cam.shoot(
+            0.0,
+            park_pose("82", "15", 4.0 + 0.5 * i as f64, 0.0),
+            raster,
+        );
+        rec.process(&img);
+    }
+    assert!(rec.background.learned().len() >= 3);
+    // asked to learn a new surface while standing on the grass: nothing is learned
+    rec.relearn(5);
+    let on_grass = park_pose("82", "15", 10.0, 6.0);
+    let grass = cam.shoot(0.0, on_grass, raster);
+    let below = |img: &CameraImage| img.pixel(160, 230);
+    for _ in 0..10 {
+        let img = cam.shoot(0.0, on_grass, raster);
+        rec.process(&img);
+    }
+    assert!(rec.relearning());
+    assert!(!rec.table.is_road(below(&grass)));
+    // it gives up after its frame budget, still without grass
+    for _ in 0..(super::RELEARN_BUDGET as usize) {
+        let img = cam.shoot(0.0, on_grass, raster);
+        rec.process(&img);
+    }
+    assert!(!rec.relearning());
+    assert!(!rec.table.is_road(below(&grass)));
+}
+
+#[test]
+fn relearning_on_a_new_road_learns_it() {
+    // a recognizer that learned the gravel of Linden Path at the start, then the asphalt of the
+    // avenue by relearning (no background learned yet: nothing beside the gravel had both
+    // edges in view)
+    let raster = &park_fixture().1;
+    let (mut rec, mut cam, _) = learned_at(park_pose("15", "100", 6.0, 0.0), 7);
+    let on_asphalt = park_pose("82", "15", 10.0, 0.0);
+    let asphalt = cam.shoot(0.0, on_asphalt, raster);
+    let below = |img: &CameraImage| img.pixel(160, 230);
+    let was_road = rec.table.is_road(below(&asphalt));
+    rec.relearn(5);
+    for _ in 0..8 {
+        let img = cam.shoot(0.0, on_asphalt, raster);
+        rec.process(&img);
+    }
+    assert!(!rec.relearning());
+    let img = cam.shoot(0.0, on_asphalt, raster);
+    assert!(
+        rec.table.is_road(below(&img)),
+        "asphalt road before: {was_road}"
+    );
+    assert!(rec.recognize(&img).rows.len() > 40);
+}

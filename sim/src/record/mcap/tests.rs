@@ -1,0 +1,230 @@
+//! Files written and read back: several channels, attachments, interrupted and cut files,
+//! garbage.
+
+use super::messages::*;
+use super::samples::{self, SCENARIO, write_all_types};
+use super::*;
+use std::path::{Path, PathBuf};
+
+const SEC: u64 = samples::SEC;
+
+fn written(dir: &Path, seconds: u64) -> (PathBuf, Vec<(&'static str, usize)>) {
+    let path = dir.join("run.mcap");
+    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let counts = write_all_types(&mut rec, seconds);
+    rec.attach("scenario.toml", "application/toml", SCENARIO.as_bytes())
+        .unwrap();
+    let stats = rec.finish().unwrap();
+    assert_eq!(
+        stats.messages as usize,
+        counts.iter().map(|c| c.1).sum::<usize>()
+    );
+    assert_eq!((stats.channels, stats.attachments), (9, 1));
+    (path, counts)
+}
+
+#[test]
+fn several_channels_read_back_in_time_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, counts) = written(dir.path(), 6);
+    let r = McapRecording::open(&path).unwrap();
+    assert_eq!(r.profile, "ros2");
+    assert!(r.damage.is_none());
+    for (topic, n) in &counts {
+        let ch = r.channel(topic).unwrap();
+        assert_eq!(ch.message_count as usize, *n, "{topic}");
+        assert_eq!(ch.message_encoding, "cdr");
+        assert_eq!(ch.schema_encoding, "ros2msg");
+    }
+    assert_eq!(
+        r.channel("/scan").unwrap().schema_name,
+        "sensor_msgs/msg/LaserScan"
+    );
+    assert!(
+        r.messages
+            .windows(2)
+            .all(|w| w[0].log_time <= w[1].log_time)
+    );
+    let a = r.attachment("scenario.toml").unwrap();
+    assert_eq!(
+        (a.media_type.as_str(), a.data.as_slice()),
+        ("application/toml", SCENARIO.as_bytes())
+    );
+    // Decoded values are the written ones.
+    let scans = r.decode_topic::<LaserScan>("/scan").unwrap();
+    assert_eq!(scans.len(), 12);
+    assert_eq!(scans[3], (SEC + SEC / 2, samples::laser_scan(1.5, 360)));
+    let odom = r.decode_topic::<Odometry>("/odom").unwrap();
+    assert_eq!(odom[0].1, samples::odometry(0.5));
+    assert_eq!(
+        r.decode_topic::<Image>("/camera/image_raw").unwrap()[5].1,
+        samples::image(5.0, 320, 240)
+    );
+    assert_eq!(
+        r.decode_topic::<TFMessage>("/tf").unwrap()[2].1,
+        samples::tf(2.0)
+    );
+    assert_eq!(
+        r.decode_topic::<NavSatFix>("/gps/fix").unwrap()[1].1,
+        samples::nav_sat_fix(1.0)
+    );
+    assert_eq!(
+        r.decode_topic::<Imu>("/imu").unwrap()[1].1,
+        samples::imu(1.0)
+    );
+    assert_eq!(
+        r.decode_topic::<Range>("/sonar/0").unwrap()[1].1,
+        samples::range(1.0)
+    );
+    // The wrong type is a clear error.
+    let e = r.decode_topic::<Imu>("/scan").unwrap_err().to_string();
+    assert!(
+        e.contains("/scan carries `sensor_msgs/msg/LaserScan`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_topic_keeps_its_type_and_schemas_are_shared() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.mcap");
+    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let a = rec.channel::<LaserScan>("/scan").unwrap();
+    let b = rec.channel::<LaserScan>("/scan").unwrap();
+    let c = rec.channel::<LaserScan>("/scan2").unwrap();
+    assert_eq!(a.id(), b.id());
+    assert_ne!(a.id(), c.id());
+    let e = rec.channel::<Imu>("/scan").err().unwrap().to_string();
+    assert!(
+        e.contains("/scan already carries sensor_msgs/msg/LaserScan"),
+        "{e}"
+    );
+    rec.finish().unwrap();
+}
+
+#[test]
+fn the_flush_period_ends_chunks() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("f.mcap");
+    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    rec.set_flush_period(Some(SEC));
+    let ch = rec.channel::<Range>("/r").unwrap();
+    for i in 0..50 {
+        rec.write(ch, i * SEC / 5, &samples::range(0.0)).unwrap();
+    }
+    let stats = rec.finish().unwrap();
+    assert_eq!(stats.chunks, 10, "one chunk per second of log time");
+}
+
+#[test]
+fn an_interrupted_writer_leaves_its_flushed_chunks_readable() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("crash.mcap");
+    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    rec.set_flush_period(None);
+    let scan = rec.channel::<LaserScan>("/scan").unwrap();
+    let cam = rec.channel::<Image>("/camera").unwrap();
+    for i in 0..10 {
+        rec.write(scan, i * SEC, &samples::laser_scan(i as f64, 100))
+            .unwrap();
+    }
+    rec.flush().unwrap();
+    for i in 10..15 {
+        rec.write(cam, i * SEC, &samples::image(i as f64, 320, 240))
+            .unwrap();
+    }
+    std::mem::forget(rec); // the process dies: no summary, unflushed bytes lost
+    let e = McapRecording::open(&path).unwrap_err().to_string();
+    assert!(
+        e.starts_with(&format!("{}: truncated MCAP file", path.display())),
+        "{e}"
+    );
+    assert!(e.contains("after 10 messages"), "{e}");
+    let r = McapRecording::open_recovering(&path).unwrap();
+    assert!(r.damage.as_deref().unwrap().contains("truncated"));
+    assert_eq!(r.messages.len(), 10);
+    assert_eq!(
+        r.decode_topic::<LaserScan>("/scan").unwrap()[9].1,
+        samples::laser_scan(9.0, 100)
+    );
+}
+
+#[test]
+fn a_cut_file_is_an_error_or_recovers_a_prefix() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("small.mcap");
+    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    rec.set_flush_period(Some(SEC));
+    let ch = rec.channel::<Odometry>("/odom").unwrap();
+    for i in 0..40 {
+        rec.write(ch, i * SEC / 4, &samples::odometry(i as f64))
+            .unwrap();
+    }
+    rec.finish().unwrap();
+    let full = std::fs::read(&path).unwrap();
+    let mut last = 0;
+    for cut in (0..full.len())
+        .step_by(97)
+        .chain([full.len() / 2, full.len() - 1])
+    {
+        let bytes = &full[..cut];
+        let e = McapRecording::from_bytes(&path, bytes, false)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
+        assert!(
+            e.contains("truncated") || e.contains("not an MCAP file"),
+            "cut {cut}: {e}"
+        );
+        if let Ok(r) = McapRecording::from_bytes(&path, bytes, true) {
+            let got = r.decode_topic::<Odometry>("/odom").unwrap_or_default();
+            for (i, (t, m)) in got.iter().enumerate() {
+                assert_eq!((*t, m), (i as u64 * SEC / 4, &samples::odometry(i as f64)));
+            }
+            assert!(
+                got.len() >= last || cut == full.len() / 2,
+                "prefix shrank at {cut}"
+            );
+            last = got.len();
+        }
+    }
+    assert_eq!(last, 40, "everything but the end magic is recovered");
+}
+
+#[test]
+fn garbage_and_flipped_bytes_are_errors_not_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, _) = written(dir.path(), 3);
+    let full = std::fs::read(&path).unwrap();
+    for junk in [
+        &b""[..],
+        b"MCAP",
+        &[0u8; 4096],
+        b"\x89MCAP0\r\n\x01\xff\xff\xff\xff\xff\xff\xff\x7f",
+    ] {
+        let e = McapRecording::from_bytes(&path, junk, true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("MCAP file"), "{e}");
+    }
+    let data_end = ::mcap::read::footer(&full).unwrap().summary_start as usize;
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    for round in 0..300 {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let mut bad = full.clone();
+        let at = (state >> 17) as usize % bad.len();
+        bad[at] ^= 1 << (round % 8);
+        let strict = McapRecording::from_bytes(&path, &bad, false);
+        let _ = McapRecording::from_bytes(&path, &bad, true);
+        if (8..data_end).contains(&at) {
+            // In the data section (or its end record): a CRC or record check catches it.
+            assert!(strict.is_err(), "flip at {at} of {data_end} went unnoticed");
+        }
+    }
+    let e = McapRecording::open(&dir.path().join("missing.mcap"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("missing.mcap: cannot read"), "{e}");
+}
