@@ -21,7 +21,7 @@ pub mod render;
 
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;
-use crate::core::{Pose2, SimClock, SimRng};
+use crate::core::{KernelPool, Pose2, SimClock, SimRng};
 use crate::world::roads::{RoadSurface, SurfaceRaster};
 use bevy_ecs::prelude::*;
 use rand::RngExt;
@@ -247,6 +247,7 @@ pub struct CameraImages {
 /// a [`RoadSurface`] the camera sees grass.
 pub fn sample_cameras(
     clock: Res<SimClock>,
+    pool: Option<Res<KernelPool>>,
     surface: Option<Res<RoadSurface>>,
     mut cameras: Query<(&TruePose, &mut Camera, &mut CameraImages)>,
 ) {
@@ -265,7 +266,11 @@ pub fn sample_cameras(
         let pose = truth.interpolate(f);
         let (w, h) = (camera.spec.width, camera.spec.height);
         let img = out.image.get_or_insert_with(|| CameraImage::new(w, h));
-        camera.capture(t, pose, raster, img);
+        // image rows render in parallel on the run's kernel pool
+        match &pool {
+            Some(p) => p.install(|| camera.capture(t, pose, raster, img)),
+            None => camera.capture(t, pose, raster, img),
+        }
         out.fresh = true;
     }
 }

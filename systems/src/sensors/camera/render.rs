@@ -18,6 +18,7 @@
 use super::GroundRays;
 use crate::core::Pose2;
 use crate::world::roads::surface_raster::{CLASSES, GRASS, SurfaceRaster};
+use rayon::prelude::*;
 
 /// Colour of one surface class (RGB, 0–255).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -161,7 +162,9 @@ pub fn render_ground(
     let ox = ((pose.x - raster.origin[0]) * inv) as f32;
     let oy = ((pose.y - raster.origin[1]) * inv) as f32;
     let ground = &mut out[3 * first * w..];
-    for (j, (px, ray)) in ground.chunks_exact_mut(3).zip(&rays.offsets).enumerate() {
+    // rows in parallel on the caller's rayon pool: a pixel's noise depends only on its index,
+    // so the image does not depend on the thread count
+    let ground_pixel = |px: &mut [u8], ray: &[f32; 2], j: usize| {
         let fx = ox + r00 * ray[0] + r01 * ray[1];
         let fy = oy + r10 * ray[0] + r11 * ray[1];
         let (ix, iy) = (floor_i32(fx), floor_i32(fy));
@@ -180,5 +183,19 @@ pub fn render_ground(
         let col: [f32; 3] =
             std::array::from_fn(|k| (cc.base[k] + 2.0 * m * cc.mottle[k]) * j_factor);
         put(px, col, pixel_noise(first * w + j));
-    }
+    };
+    let render_row = |(row, (line, offsets)): (usize, (&mut [u8], &[[f32; 2]]))| {
+        for (u, (px, ray)) in line.chunks_exact_mut(3).zip(offsets).enumerate() {
+            ground_pixel(px, ray, row * w + u);
+        }
+    };
+    ground
+        .par_chunks_mut(3 * w)
+        .zip(rays.offsets.par_chunks(w))
+        .enumerate()
+        .with_min_len(ROWS_PER_TASK)
+        .for_each(render_row);
 }
+
+/// Image rows rendered per rayon task.
+const ROWS_PER_TASK: usize = 8;

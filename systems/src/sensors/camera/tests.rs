@@ -120,6 +120,19 @@ fn same_seed_same_image() {
     // noise and brightness change from frame to frame and with the seed
     assert_ne!(a.rgb, b.rgb);
     assert_ne!(a.rgb, shoot(6).0.rgb);
+    // rows render in parallel: the image does not depend on the number of threads
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let (a3, b3) = pool.install(|| shoot(5));
+        assert_eq!(
+            (a3.rgb, b3.rgb),
+            (a.rgb.clone(), b.rgb.clone()),
+            "{threads} threads"
+        );
+    }
 }
 
 #[test]
