@@ -233,37 +233,29 @@ impl RoadMcl {
         along += d;
         for _ in 0..64 {
             let len = dir.length(graph);
-            if along > len {
-                next_edges(graph, dir, &mut self.options);
-                let Some(o) = choose_by_compass(
-                    graph,
-                    &self.options,
-                    compass,
-                    c.compass_sigma,
-                    c.turn_floor,
-                    u,
-                ) else {
-                    break;
-                };
-                along -= len;
-                dir = o;
-            } else if along < 0.0 {
-                prev_edges(graph, dir, &mut self.options);
-                let Some(o) = choose_by_compass(
-                    graph,
-                    &self.options,
-                    compass,
-                    c.compass_sigma,
-                    c.turn_floor,
-                    u,
-                ) else {
-                    break;
-                };
-                along += o.length(graph);
-                dir = o;
-            } else {
+            // past the edge's head: on along an edge leaving it; before its tail: back onto
+            // an edge arriving there
+            let ahead = along > len;
+            if !ahead && along >= 0.0 {
                 break;
             }
+            if ahead {
+                next_edges(graph, dir, &mut self.options);
+            } else {
+                prev_edges(graph, dir, &mut self.options);
+            }
+            let Some(o) = choose_by_compass(
+                graph,
+                &self.options,
+                compass,
+                c.compass_sigma,
+                c.turn_floor,
+                u,
+            ) else {
+                break;
+            };
+            along += if ahead { -len } else { o.length(graph) };
+            dir = o;
         }
         self.particles[i].dir = dir;
         self.particles[i].along = along.clamp(0.0, dir.length(graph));
