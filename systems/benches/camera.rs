@@ -1,8 +1,9 @@
 //! Camera on the park (assets/roads/park/park.osm): rendering one 320×240 frame from the
 //! rasterized road surface (0.05 m cells) on Basilica Avenue, the thesis's road recognition of
 //! one frame with learned colours (004_95e533f2514531b8.txt §5.2: rows bottom-up with step 2,
-//! pixels from the centre out with step 4, one 64³ table read per pixel), the road follower on
-//! the detection, and the one-off rasterization of the park.
+//! pixels from the centre out with step 4, one 64³ table read per pixel) of a rendered frame
+//! and of a frame whose pixels are computed as the recognizer reads them (what a run does),
+//! the road follower on the detection, and the one-off rasterization of the park.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
@@ -57,6 +58,11 @@ fn bench_camera(c: &mut Criterion) {
     });
     grp.bench_function("recognize_320x240", |b| {
         b.iter(|| black_box(rec.recognize(black_box(&img))))
+    });
+    // what a run does per frame: the recognizer computes only the pixels it reads
+    let frame = cam.take(0.0, pose);
+    grp.bench_function("take_and_recognize_320x240", |b| {
+        b.iter(|| black_box(rec.recognize(&cam.view(black_box(&frame), &raster))))
     });
     let params = RoadFollowParams::default();
     grp.bench_function("road_steering", |b| {

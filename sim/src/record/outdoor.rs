@@ -20,12 +20,13 @@
 use super::rrd::RrdRecorder;
 use bevy_ecs::prelude::*;
 use systems::body::TruePose;
-use systems::core::{RobotId, RobotIndex, SimClock};
+use systems::core::{KernelPool, RobotId, RobotIndex, SimClock};
 use systems::localization::road_wiring::RoadLocalization;
 use systems::navigation::road_drive::RoadNavigator;
 use systems::navigation::road_recognition::{RoadDetector, draw_detection};
-use systems::sensors::CameraImages;
-use systems::world::roads::{RoadGraph, RoadMap, Surface};
+use systems::sensors::camera::surface_or_grass;
+use systems::sensors::{Camera, CameraImages};
+use systems::world::roads::{RoadGraph, RoadMap, RoadSurface, Surface, SurfaceRaster};
 use systems::world::{ZoneKind, ZoneShape, Zones};
 
 /// Per robot: what has been logged already.
@@ -156,19 +157,24 @@ pub fn record_outdoor(
     clock: Res<SimClock>,
     mut r: ResMut<RrdRecorder>,
     mut state: ResMut<OutdoorRecording>,
-    roads: Option<Res<RoadMap>>,
-    zones: Option<Res<Zones>>,
+    (roads, zones, surface): (
+        Option<Res<RoadMap>>,
+        Option<Res<Zones>>,
+        Option<Res<RoadSurface>>,
+    ),
+    pool: Option<Res<KernelPool>>,
     robots: Query<(
         &RobotIndex,
         &RobotId,
         &TruePose,
         Option<&RoadLocalization>,
         Option<&RoadNavigator>,
-        Option<(&CameraImages, &RoadDetector)>,
+        Option<(&Camera, &CameraImages, &RoadDetector)>,
     )>,
 ) {
     let Some(roads) = roads else { return };
     let g = &*roads.0;
+    let empty = SurfaceRaster::empty();
     let r = &mut *r;
     let now = clock.now();
     if !state.started {
@@ -299,13 +305,18 @@ pub fn record_outdoor(
             logged.events = nav.events.len();
             r.rec.set_duration_secs("sim_time", now);
         }
-        if let Some((images, det)) = camera
+        if let Some((camera, images, det)) = camera
             && images.fresh
             && now >= logged.camera_at + camera_period - 1e-9
-            && let Some(img) = &images.image
+            && let Some(frame) = &images.frame
         {
             logged.camera_at = now;
-            let mut drawn = img.clone();
+            let raster = surface_or_grass(surface.as_deref(), &empty);
+            // the whole frame, rows in parallel on the run's kernel pool
+            let mut drawn = match &pool {
+                Some(p) => p.install(|| camera.render(frame, raster)),
+                None => camera.render(frame, raster),
+            };
             if let Some(d) = &det.detection {
                 draw_detection(&mut drawn, d);
             }

@@ -4,7 +4,7 @@
 //! robot standing on the grass never learns grass as road.
 
 use super::{BACKGROUND_COLOURS, RELEARN_BUDGET, RoadDetection, RoadRecognizer};
-use crate::sensors::camera::CameraImage;
+use crate::sensors::camera::Pixels;
 
 impl RoadRecognizer {
     /// Whether frames are still being learned from.
@@ -13,7 +13,7 @@ impl RoadRecognizer {
     }
 
     /// Learns the colours in the learning window; returns how many were new.
-    pub fn learn(&mut self, image: &CameraImage) -> usize {
+    pub fn learn(&mut self, image: &impl Pixels) -> usize {
         let pixels: Vec<[u8; 3]> = self.window_pixels(image).collect();
         let added = pixels
             .into_iter()
@@ -37,8 +37,8 @@ impl RoadRecognizer {
     }
 
     /// The learning window's pixels (row-major, `learn_step` apart).
-    pub(super) fn window_pixels(&self, image: &CameraImage) -> impl Iterator<Item = [u8; 3]> {
-        let (w, h) = (image.width as f64, image.height as f64);
+    pub(super) fn window_pixels(&self, image: &impl Pixels) -> impl Iterator<Item = [u8; 3]> {
+        let (w, h) = (image.width() as f64, image.height() as f64);
         let [l, t, r, b] = self.config.window;
         let col = |f: f64, n: f64| ((f * n).round() as u32).min(n as u32);
         let (u0, u1) = (col(l, w), col(r, w));
@@ -51,7 +51,7 @@ impl RoadRecognizer {
 
     /// One frame of relearning: learns the window's colours that are not background when
     /// most of them are not (the robot is on a road), else waits for a better frame.
-    pub(super) fn relearn_from(&mut self, image: &CameraImage) {
+    pub(super) fn relearn_from(&mut self, image: &impl Pixels) {
         self.relearn_budget -= 1;
         let pixels: Vec<[u8; 3]> = self.window_pixels(image).collect();
         let clear = pixels
@@ -71,11 +71,11 @@ impl RoadRecognizer {
 
     /// Learns colours beside a road recognized with both edges in the near rows: the
     /// background a new road must differ from.
-    pub(super) fn learn_background(&mut self, image: &CameraImage, det: &RoadDetection) {
+    pub(super) fn learn_background(&mut self, image: &impl Pixels, det: &RoadDetection) {
         if self.background.learned().len() >= BACKGROUND_COLOURS {
             return;
         }
-        let w = image.width as f64;
+        let w = image.width() as f64;
         let gap = 2.0 * self.config.pixel_step as f64;
         for row in det
             .rows

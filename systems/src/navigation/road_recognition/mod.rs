@@ -22,7 +22,8 @@
 pub mod colour_table;
 mod learning;
 
-use crate::sensors::camera::{CameraImage, CameraImages};
+use crate::sensors::camera::{Camera, CameraImage, CameraImages, Pixels, surface_or_grass};
+use crate::world::roads::{RoadSurface, SurfaceRaster};
 use bevy_ecs::prelude::*;
 pub use colour_table::ColourTable;
 
@@ -143,7 +144,7 @@ impl RoadRecognizer {
     }
 
     /// Learns from the frame while learning, then finds the road in it.
-    pub fn process(&mut self, image: &CameraImage) -> RoadDetection {
+    pub fn process(&mut self, image: &impl Pixels) -> RoadDetection {
         let learning = self.learning();
         if learning {
             self.learn(image);
@@ -159,9 +160,9 @@ impl RoadRecognizer {
     }
 
     /// Finds the road in `image` with the colours learned so far.
-    pub fn recognize(&self, image: &CameraImage) -> RoadDetection {
+    pub fn recognize(&self, image: &impl Pixels) -> RoadDetection {
         let c = &self.config;
-        let (w, h) = (image.width as i64, image.height as i64);
+        let (w, h) = (image.width() as i64, image.height() as i64);
         let step = c.pixel_step.max(1) as i64;
         let mut rows = Vec::new();
         let mut start = w / 2;
@@ -189,9 +190,9 @@ impl RoadRecognizer {
             v -= c.row_step.max(1) as i64;
         }
         RoadDetection {
-            stamp: image.stamp,
-            width: image.width,
-            height: image.height,
+            stamp: image.stamp(),
+            width: image.width(),
+            height: image.height(),
             learning: false,
             rows,
         }
@@ -202,14 +203,14 @@ impl RoadRecognizer {
     /// across the whole half-row.
     fn scan_side(
         &self,
-        image: &CameraImage,
+        image: &impl Pixels,
         v: u32,
         start: i64,
         dir: i64,
         step: i64,
         seek: bool,
     ) -> Side {
-        let w = image.width as i64;
+        let w = image.width() as i64;
         let mut side = Side {
             first: None,
             last: None,
@@ -237,8 +238,8 @@ impl RoadRecognizer {
     }
 
     /// The road in row `v`, scanning out from column `start`.
-    fn scan_row(&self, image: &CameraImage, v: u32, start: i64, step: i64) -> Option<RoadRow> {
-        let w = image.width as f64;
+    fn scan_row(&self, image: &impl Pixels, v: u32, start: i64, step: i64) -> Option<RoadRow> {
+        let w = image.width() as f64;
         let half = 0.5 * step as f64;
         let on_road = self.table.is_road(image.pixel(start as u32, v));
         // the thesis gives up on a row whose start is off the road; we look along it
@@ -329,15 +330,20 @@ impl RoadDetector {
     }
 }
 
-/// Recognizes the road in every fresh camera image.
-pub fn detect_roads(mut detectors: Query<(&CameraImages, &mut RoadDetector)>) {
-    for (images, mut det) in detectors.iter_mut() {
+/// Recognizes the road in every fresh camera frame, computing only the pixels it reads.
+pub fn detect_roads(
+    surface: Option<Res<RoadSurface>>,
+    mut detectors: Query<(&Camera, &CameraImages, &mut RoadDetector)>,
+) {
+    let empty = SurfaceRaster::empty();
+    let raster = surface_or_grass(surface.as_deref(), &empty);
+    for (camera, images, mut det) in detectors.iter_mut() {
         det.fresh = false;
         if !images.fresh {
             continue;
         }
-        if let Some(img) = &images.image {
-            let d = det.recognizer.process(img);
+        if let Some(frame) = &images.frame {
+            let d = det.recognizer.process(&camera.view(frame, raster));
             det.detection = Some(d);
             det.fresh = true;
         }

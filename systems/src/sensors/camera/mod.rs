@@ -21,12 +21,12 @@ pub mod render;
 
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;
-use crate::core::{KernelPool, Pose2, SimClock, SimRng};
+use crate::core::{Pose2, SimClock, SimRng};
 use crate::world::roads::{RoadSurface, SurfaceRaster};
 use bevy_ecs::prelude::*;
 use rand::RngExt;
 use rand_distr::StandardNormal;
-pub use render::{FrameParams, Palette, render_ground};
+pub use render::{FrameParams, FrameView, Palette, render_ground};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraSpec {
@@ -198,7 +198,48 @@ impl Camera {
         }
     }
 
-    /// Takes a frame at robot pose `pose` (world frame) into `out` (resized if needed).
+    /// Takes a frame at robot pose `pose` (world frame): draws its brightness and noise seed.
+    /// No pixel is computed until asked for ([`Camera::view`], [`Camera::render`]).
+    pub fn take(&mut self, stamp: f64, pose: Pose2) -> CameraFrame {
+        let n: f64 = self.rng.sample(StandardNormal);
+        CameraFrame {
+            stamp,
+            pose,
+            params: FrameParams {
+                brightness: (1.0 + self.spec.brightness_std * n).max(0.05) as f32,
+                noise_std: self.spec.noise_std as f32,
+                seed: self.rng.random(),
+            },
+        }
+    }
+
+    /// The pixels of `frame` over the road surface `raster`, computed one by one on request.
+    pub fn view<'a>(&'a self, frame: &CameraFrame, raster: &'a SurfaceRaster) -> CameraView<'a> {
+        CameraView {
+            stamp: frame.stamp,
+            pixels: FrameView::new(&self.rays, frame.pose, raster, &self.palette, frame.params),
+        }
+    }
+
+    /// Renders the whole of `frame` into `out` (resized if needed); rows in parallel on the
+    /// caller's rayon pool.
+    pub fn render_into(&self, frame: &CameraFrame, raster: &SurfaceRaster, out: &mut CameraImage) {
+        out.stamp = frame.stamp;
+        out.width = self.spec.width;
+        out.height = self.spec.height;
+        out.rgb
+            .resize((self.spec.width * self.spec.height * 3) as usize, 0);
+        self.view(frame, raster).pixels.render(&mut out.rgb);
+    }
+
+    /// The whole image of `frame`.
+    pub fn render(&self, frame: &CameraFrame, raster: &SurfaceRaster) -> CameraImage {
+        let mut img = CameraImage::new(self.spec.width, self.spec.height);
+        self.render_into(frame, raster, &mut img);
+        img
+    }
+
+    /// Takes a frame at robot pose `pose` (world frame) and renders it into `out`.
     pub fn capture(
         &mut self,
         stamp: f64,
@@ -206,54 +247,90 @@ impl Camera {
         raster: &SurfaceRaster,
         out: &mut CameraImage,
     ) {
-        let n: f64 = self.rng.sample(StandardNormal);
-        let frame = FrameParams {
-            brightness: (1.0 + self.spec.brightness_std * n).max(0.05) as f32,
-            noise_std: self.spec.noise_std as f32,
-            seed: self.rng.random(),
-        };
-        out.stamp = stamp;
-        out.width = self.spec.width;
-        out.height = self.spec.height;
-        out.rgb
-            .resize((self.spec.width * self.spec.height * 3) as usize, 0);
-        render_ground(
-            &self.rays,
-            pose,
-            raster,
-            &self.palette,
-            &frame,
-            &mut out.rgb,
-        );
+        let frame = self.take(stamp, pose);
+        self.render_into(&frame, raster, out);
     }
 
     /// A new image of this camera's size, taken at `pose`.
     pub fn shoot(&mut self, stamp: f64, pose: Pose2, raster: &SurfaceRaster) -> CameraImage {
-        let mut img = CameraImage::new(self.spec.width, self.spec.height);
-        self.capture(stamp, pose, raster, &mut img);
-        img
+        let frame = self.take(stamp, pose);
+        self.render(&frame, raster)
     }
 }
 
-/// The latest frame of a camera.
+/// What makes a frame: when and where it was taken and its random draws.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraFrame {
+    pub stamp: f64,
+    /// The robot's true pose (world frame) when it was taken.
+    pub pose: Pose2,
+    pub params: FrameParams,
+}
+
+/// A frame whose pixels are computed when read: what the road recognizer looks at.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraView<'a> {
+    pub stamp: f64,
+    pub pixels: FrameView<'a>,
+}
+
+/// An image the road recognizer can read: a rendered [`CameraImage`] or a [`CameraView`].
+pub trait Pixels {
+    fn stamp(&self) -> f64;
+    fn width(&self) -> u32;
+    fn height(&self) -> u32;
+    /// The colour of pixel (u, v) (u < width, v < height).
+    fn pixel(&self, u: u32, v: u32) -> [u8; 3];
+}
+
+impl Pixels for CameraImage {
+    fn stamp(&self) -> f64 {
+        self.stamp
+    }
+    fn width(&self) -> u32 {
+        self.width
+    }
+    fn height(&self) -> u32 {
+        self.height
+    }
+    #[inline]
+    fn pixel(&self, u: u32, v: u32) -> [u8; 3] {
+        CameraImage::pixel(self, u, v)
+    }
+}
+
+impl Pixels for CameraView<'_> {
+    fn stamp(&self) -> f64 {
+        self.stamp
+    }
+    fn width(&self) -> u32 {
+        self.pixels.width()
+    }
+    fn height(&self) -> u32 {
+        self.pixels.height()
+    }
+    #[inline]
+    fn pixel(&self, u: u32, v: u32) -> [u8; 3] {
+        self.pixels.pixel(u, v)
+    }
+}
+
+/// The latest frame of a camera. Pixels are computed on demand: the road recognizer reads a
+/// few of them through [`Camera::view`], recorders render whole frames ([`Camera::render`])
+/// at their own rate. Both see the same pixels.
 #[derive(Component, Clone, Debug, Default)]
 pub struct CameraImages {
-    pub image: Option<CameraImage>,
+    pub frame: Option<CameraFrame>,
     /// True only in the tick the frame was taken.
     pub fresh: bool,
 }
 
-/// Sense: the last frame due in this tick (earlier ones of the same tick are skipped). Without
-/// a [`RoadSurface`] the camera sees grass.
+/// Sense: the last frame due in this tick (earlier ones of the same tick are skipped).
 pub fn sample_cameras(
     clock: Res<SimClock>,
-    pool: Option<Res<KernelPool>>,
-    surface: Option<Res<RoadSurface>>,
     mut cameras: Query<(&TruePose, &mut Camera, &mut CameraImages)>,
 ) {
     let (start, end, dt) = (clock.start(), clock.now(), clock.dt);
-    let empty = SurfaceRaster::empty();
-    let raster: &SurfaceRaster = surface.as_ref().map_or(&empty, |s| &s.0);
     let mut due = Vec::new();
     for (truth, mut camera, mut out) in cameras.iter_mut() {
         out.fresh = false;
@@ -263,16 +340,17 @@ pub fn sample_cameras(
             continue;
         }
         let f = ((t - start) / dt).clamp(0.0, 1.0);
-        let pose = truth.interpolate(f);
-        let (w, h) = (camera.spec.width, camera.spec.height);
-        let img = out.image.get_or_insert_with(|| CameraImage::new(w, h));
-        // image rows render in parallel on the run's kernel pool
-        match &pool {
-            Some(p) => p.install(|| camera.capture(t, pose, raster, img)),
-            None => camera.capture(t, pose, raster, img),
-        }
+        out.frame = Some(camera.take(t, truth.interpolate(f)));
         out.fresh = true;
     }
+}
+
+/// The road surface cameras see: the scenario's, or grass everywhere without roads.
+pub fn surface_or_grass<'a>(
+    surface: Option<&'a RoadSurface>,
+    empty: &'a SurfaceRaster,
+) -> &'a SurfaceRaster {
+    surface.map_or(empty, |s| &s.0)
 }
 
 #[cfg(test)]

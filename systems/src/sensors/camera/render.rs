@@ -109,71 +109,127 @@ fn floor_i32(v: f32) -> i32 {
 /// Standard deviation of the sum of two independent uniform bytes minus 255.
 const TRIANGULAR_STD: f32 = 104.52;
 
-/// Renders the view from robot pose `pose` (world frame) into `out`: RGB8, row-major, row 0 at
-/// the top, `rays.width × rays.height × 3` bytes.
-pub fn render_ground(
-    rays: &GroundRays,
-    pose: Pose2,
-    raster: &SurfaceRaster,
-    palette: &Palette,
-    frame: &FrameParams,
-    out: &mut [u8],
-) {
-    let (w, h) = (rays.width as usize, rays.height as usize);
-    assert_eq!(out.len(), w * h * 3, "output buffer size");
-    let noise_scale = frame.noise_std / TRIANGULAR_STD;
-    let gain = frame.brightness;
-    let put = |px: &mut [u8], c: [f32; 3], n: u64| {
-        for (k, o) in px.iter_mut().enumerate() {
-            let a = ((n >> (16 * k)) & 0xff) as f32;
-            let b = ((n >> (16 * k + 8)) & 0xff) as f32;
-            let v = c[k] * gain + (a + b - 255.0) * noise_scale;
-            *o = v.clamp(0.0, 255.0) as u8;
-        }
-    };
-    let pixel_noise = |i: usize| mix64(frame.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+/// One frame of the view from a robot pose: any pixel can be computed on its own
+/// ([`FrameView::pixel`]), or the whole image at once ([`FrameView::render`]); both give the
+/// same bytes, since a pixel depends only on the pose, the frame's draws and its own index.
+/// The road recognizer reads about a tenth of a frame, so a run computes only those pixels
+/// and renders whole frames only for recordings.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameView<'a> {
+    rays: &'a GroundRays,
+    raster: &'a SurfaceRaster,
+    palette: &'a Palette,
+    frame: FrameParams,
+    /// Ray offsets (robot frame, m) to raster cells: rotation (scaled by 1 / resolution) ...
+    r: [f32; 4],
+    /// ... and the pose's cell position.
+    o: [f32; 2],
+    noise_scale: f32,
+}
 
-    // sky
-    let first = (rays.first_ground_row as usize).min(h);
-    for v in 0..first {
+impl<'a> FrameView<'a> {
+    pub fn new(
+        rays: &'a GroundRays,
+        pose: Pose2,
+        raster: &'a SurfaceRaster,
+        palette: &'a Palette,
+        frame: FrameParams,
+    ) -> Self {
+        let inv = 1.0 / raster.resolution;
+        let (s, c) = pose.theta.sin_cos();
+        FrameView {
+            rays,
+            raster,
+            palette,
+            frame,
+            r: [
+                (c * inv) as f32,
+                (-s * inv) as f32,
+                (s * inv) as f32,
+                (c * inv) as f32,
+            ],
+            o: [
+                ((pose.x - raster.origin[0]) * inv) as f32,
+                ((pose.y - raster.origin[1]) * inv) as f32,
+            ],
+            noise_scale: frame.noise_std / TRIANGULAR_STD,
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.rays.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.rays.height
+    }
+
+    /// The colour of pixel (u, v) (u < width, v < height).
+    #[inline]
+    pub fn pixel(&self, u: u32, v: u32) -> [u8; 3] {
+        let w = self.rays.width as usize;
+        let i = v as usize * w + u as usize;
+        let first = self.rays.first_ground_row;
+        if v < first {
+            self.shade(self.sky(v), i)
+        } else {
+            self.ground(&self.rays.offsets[i - first as usize * w], i)
+        }
+    }
+
+    /// The whole image into `out`: RGB8, row-major, row 0 at the top,
+    /// `width × height × 3` bytes. Rows render in parallel on the caller's rayon pool; the
+    /// image does not depend on the thread count.
+    pub fn render(&self, out: &mut [u8]) {
+        let (w, h) = (self.rays.width as usize, self.rays.height as usize);
+        assert_eq!(out.len(), w * h * 3, "output buffer size");
+        let first = (self.rays.first_ground_row as usize).min(h);
+        let (sky, ground) = out.split_at_mut(3 * first * w);
+        for (v, line) in sky.chunks_exact_mut(3 * w).enumerate() {
+            let c = self.sky(v as u32);
+            for (u, px) in line.chunks_exact_mut(3).enumerate() {
+                px.copy_from_slice(&self.shade(c, v * w + u));
+            }
+        }
+        let render_row = |(row, (line, offsets)): (usize, (&mut [u8], &[[f32; 2]]))| {
+            let i0 = (first + row) * w;
+            for (u, (px, ray)) in line.chunks_exact_mut(3).zip(offsets).enumerate() {
+                px.copy_from_slice(&self.ground(ray, i0 + u));
+            }
+        };
+        ground
+            .par_chunks_mut(3 * w)
+            .zip(self.rays.offsets.par_chunks(w))
+            .enumerate()
+            .with_min_len(ROWS_PER_TASK)
+            .for_each(render_row);
+    }
+
+    /// The sky's colour in row `v` (above the horizon): a gradient down to the horizon.
+    fn sky(&self, v: u32) -> [f32; 3] {
+        let first = self.rays.first_ground_row;
         let t = if first > 1 {
             v as f32 / (first - 1) as f32
         } else {
             1.0
         };
-        let c: [f32; 3] = std::array::from_fn(|k| {
-            palette.sky_top[k] + t * (palette.sky_horizon[k] - palette.sky_top[k])
-        });
-        for u in 0..w {
-            let i = v * w + u;
-            put(&mut out[3 * i..3 * i + 3], c, pixel_noise(i));
-        }
+        let p = self.palette;
+        std::array::from_fn(|k| p.sky_top[k] + t * (p.sky_horizon[k] - p.sky_top[k]))
     }
 
-    // ground: the ray offsets (robot frame, m) rotated and translated into raster cells
-    let inv = 1.0 / raster.resolution;
-    let (s, c) = pose.theta.sin_cos();
-    let (r00, r01, r10, r11) = (
-        (c * inv) as f32,
-        (-s * inv) as f32,
-        (s * inv) as f32,
-        (c * inv) as f32,
-    );
-    let ox = ((pose.x - raster.origin[0]) * inv) as f32;
-    let oy = ((pose.y - raster.origin[1]) * inv) as f32;
-    let ground = &mut out[3 * first * w..];
-    // rows in parallel on the caller's rayon pool: a pixel's noise depends only on its index,
-    // so the image does not depend on the thread count
-    let ground_pixel = |px: &mut [u8], ray: &[f32; 2], j: usize| {
-        let fx = ox + r00 * ray[0] + r01 * ray[1];
-        let fy = oy + r10 * ray[0] + r11 * ray[1];
+    /// The ground colour under ray `ray` (robot frame offset, m), for pixel index `i`.
+    #[inline]
+    fn ground(&self, ray: &[f32; 2], i: usize) -> [u8; 3] {
+        let [r00, r01, r10, r11] = self.r;
+        let fx = self.o[0] + r00 * ray[0] + r01 * ray[1];
+        let fy = self.o[1] + r10 * ray[0] + r11 * ray[1];
         let (ix, iy) = (floor_i32(fx), floor_i32(fy));
         let class = if fx.is_finite() && fy.is_finite() {
-            raster.class_at_cell(ix as i64, iy as i64)
+            self.raster.class_at_cell(ix as i64, iy as i64)
         } else {
             GRASS
         };
-        let cc = &palette.classes[class as usize];
+        let cc = &self.palette.classes[class as usize];
         let m = 0.65 * cell_hash(ix >> 3, iy >> 3) + 0.35 * cell_hash(ix >> 1, iy >> 1) - 0.5;
         let j_factor = if cc.joints != 1.0 && ((ix & 3) == 0 || (iy & 3) == 0) {
             cc.joints
@@ -182,19 +238,33 @@ pub fn render_ground(
         };
         let col: [f32; 3] =
             std::array::from_fn(|k| (cc.base[k] + 2.0 * m * cc.mottle[k]) * j_factor);
-        put(px, col, pixel_noise(first * w + j));
-    };
-    let render_row = |(row, (line, offsets)): (usize, (&mut [u8], &[[f32; 2]]))| {
-        for (u, (px, ray)) in line.chunks_exact_mut(3).zip(offsets).enumerate() {
-            ground_pixel(px, ray, row * w + u);
-        }
-    };
-    ground
-        .par_chunks_mut(3 * w)
-        .zip(rays.offsets.par_chunks(w))
-        .enumerate()
-        .with_min_len(ROWS_PER_TASK)
-        .for_each(render_row);
+        self.shade(col, i)
+    }
+
+    /// Colour `c` of pixel index `i` with the frame's brightness and the pixel's own noise.
+    #[inline]
+    fn shade(&self, c: [f32; 3], i: usize) -> [u8; 3] {
+        let n = mix64(self.frame.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        std::array::from_fn(|k| {
+            let a = ((n >> (16 * k)) & 0xff) as f32;
+            let b = ((n >> (16 * k + 8)) & 0xff) as f32;
+            let v = c[k] * self.frame.brightness + (a + b - 255.0) * self.noise_scale;
+            v.clamp(0.0, 255.0) as u8
+        })
+    }
+}
+
+/// Renders the view from robot pose `pose` (world frame) into `out`: RGB8, row-major, row 0 at
+/// the top, `rays.width × rays.height × 3` bytes ([`FrameView::render`]).
+pub fn render_ground(
+    rays: &GroundRays,
+    pose: Pose2,
+    raster: &SurfaceRaster,
+    palette: &Palette,
+    frame: &FrameParams,
+    out: &mut [u8],
+) {
+    FrameView::new(rays, pose, raster, palette, *frame).render(out);
 }
 
 /// Image rows rendered per rayon task.

@@ -155,15 +155,20 @@ fn the_system_takes_the_last_frame_due_and_sees_grass_without_roads() {
         let out = world.get::<CameraImages>(e).unwrap();
         fresh.push(out.fresh);
         if out.fresh {
-            let img = out.image.as_ref().unwrap();
+            let frame = out.frame.as_ref().unwrap();
             let t = world.resource::<SimClock>().now();
-            assert!((img.stamp - (t - 0.05)).abs() < 1e-9 || (img.stamp - t).abs() < 1e-9);
+            assert!((frame.stamp - (t - 0.05)).abs() < 1e-9 || (frame.stamp - t).abs() < 1e-9);
         }
         world.resource_mut::<SimClock>().advance();
     }
     // 10 Hz on 50 ms ticks: t = 0 in the first tick, then 0.1, 0.2 at the ends of ticks 2, 4
     assert_eq!(fresh, [true, true, false, true, false, true]);
-    let img = world.get::<CameraImages>(e).unwrap().image.clone().unwrap();
+    let frame = world.get::<CameraImages>(e).unwrap().frame.unwrap();
+    let empty = SurfaceRaster::empty();
+    let img = world
+        .get::<Camera>(e)
+        .unwrap()
+        .render(&frame, surface_or_grass(None, &empty));
     let ground = mean_colour(&img, 0..320, 120..240);
     assert!(ground[1] > ground[0] + 20.0, "grass everywhere {ground:?}");
 
@@ -174,12 +179,27 @@ fn the_system_takes_the_last_frame_due_and_sees_grass_without_roads() {
         assert!(!world.get::<CameraImages>(e).unwrap().fresh);
         world.resource_mut::<SimClock>().advance();
     }
-    let stamp = world
-        .get::<CameraImages>(e)
-        .unwrap()
-        .image
-        .as_ref()
-        .unwrap()
-        .stamp;
+    let stamp = world.get::<CameraImages>(e).unwrap().frame.unwrap().stamp;
     assert!((stamp - 0.3).abs() < 1e-9, "{stamp}");
+}
+
+#[test]
+fn pixels_read_one_by_one_equal_the_rendered_image() {
+    let (_, raster) = park_fixture();
+    let mut cam = Camera::new(CameraSpec::default(), stream_rng(9, "r", "camera"));
+    // on the road and beside it: road, verges, grass and sky
+    for pose in [
+        park_pose("82", "15", 3.0, 0.0),
+        park_pose("82", "15", 8.0, 4.0),
+    ] {
+        let frame = cam.take(0.0, pose);
+        let img = cam.render(&frame, raster);
+        let view = cam.view(&frame, raster);
+        assert_eq!((Pixels::width(&view), Pixels::height(&view)), (320, 240));
+        for v in 0..240 {
+            for u in 0..320 {
+                assert_eq!(view.pixel(u, v), img.pixel(u, v), "pixel ({u}, {v})");
+            }
+        }
+    }
 }
