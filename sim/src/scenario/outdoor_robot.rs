@@ -69,7 +69,8 @@ pub struct RouteFile {
     pub navigate_by: Option<String>,
     /// Cruise speed (m/s, default 1).
     pub speed: Option<f64>,
-    /// Arrival radius around the goal node (m, default 3).
+    /// The robot stops when its belief is this close to the goal node (m, default 1). The run
+    /// counts as reached when it truly stopped within 5 m.
     pub tolerance: Option<f64>,
 }
 
@@ -324,7 +325,7 @@ pub(super) fn resolve_route(
         goal,
         navigate_by,
         speed: c.opt_positive(&p.key("speed"), f.speed, 1.0)?,
-        tolerance: c.opt_positive(&p.key("tolerance"), f.tolerance, 3.0)?,
+        tolerance: c.opt_positive(&p.key("tolerance"), f.tolerance, 1.0)?,
     };
     let (a, b) = (g.nodes[start].pos, g.nodes[toward].pos);
     let t = along / length.max(1e-9);

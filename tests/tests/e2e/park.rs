@@ -80,3 +80,30 @@ fn the_same_seed_drives_the_same_park_run() {
     );
     assert!(a.summary.robots[0].distance_m > 10.0);
 }
+
+/// Issue item: the short route (the one that needs a U-turn by the shortest path) reaches its
+/// goal over 20 seeds at a rate of at least 90 %, navigating by either road localizer
+/// (`sim experiment park --routes park_route_short --runs 20`; about 45 s on 2 cores).
+#[test]
+fn the_short_route_reaches_its_goal_in_nine_of_ten_seeds_by_either_localizer() {
+    use sim::experiment::park::{ParkOptions, run_park_experiment};
+    let (rows, runs) = run_park_experiment(&ParkOptions {
+        routes: vec!["park_route_short".into()],
+        runs: 20,
+        threads: 0,
+        progress: false,
+    })
+    .unwrap();
+    assert_eq!(rows.len(), 2);
+    assert_eq!(runs.len(), 40);
+    for r in &rows {
+        assert_eq!(r.runs, 20);
+        assert!(
+            r.reached_percent >= 90.0,
+            "{} by {}: {} % reached",
+            r.route,
+            r.navigate_by,
+            r.reached_percent
+        );
+    }
+}

@@ -34,7 +34,8 @@ pub struct RoadNavParams {
     pub speed: f64,
     /// Speed through junctions and while not yet localized (fraction of `speed`).
     pub slow_factor: f64,
-    /// The robot is there when the belief puts it this close to the goal node (m).
+    /// The robot stops when the belief puts it this close to the goal node (m), before or
+    /// just past it.
     pub tolerance: f64,
     /// A junction manoeuvre starts this far before the node (m)…
     pub junction_radius: f64,
@@ -64,7 +65,7 @@ impl Default for RoadNavParams {
         RoadNavParams {
             speed: 1.0,
             slow_factor: 0.6,
-            tolerance: 3.0,
+            tolerance: 1.0,
             junction_radius: 4.0,
             exit_distance: 3.0,
             stop_distance: 0.8,
@@ -145,6 +146,8 @@ pub struct RoadNavigator {
     route_start: Option<(EdgeId, NodeId)>,
     /// The last directed edge a plan failed from (so a failure is not retried every tick).
     failed_from: Option<(EdgeId, NodeId)>,
+    /// A belief has put the robot on an edge towards the goal.
+    goal_ahead: bool,
     pub stats: RoadNavStats,
     /// Road surfaces the camera has learned the colours of.
     pub learned: Vec<Surface>,
@@ -162,6 +165,7 @@ impl RoadNavigator {
             first_route_length: None,
             route_start: None,
             failed_from: None,
+            goal_ahead: false,
             stats: RoadNavStats::default(),
             learned: Vec::new(),
             events: Vec::new(),
@@ -353,7 +357,7 @@ impl RoadNavigator {
             self.phase = RoadPhase::TurningRound { azimuth: back };
             return (0.0, 0.0);
         }
-        if b.toward == self.goal && b.remaining <= p.tolerance {
+        if self.at_goal(graph, b, p.tolerance) {
             self.phase = RoadPhase::Arrived;
             self.stats.arrived_at = Some(input.now);
             self.events.push((input.now, "arrived".into()));
@@ -457,6 +461,21 @@ fn lateral_gap(c: [f64; 2], m: [f64; 2]) -> f64 {
 /// Angle (rad) between two directions from the robot.
 fn angle_between(a: [f64; 2], b: [f64; 2]) -> f64 {
     wrap_angle(a[1].atan2(a[0]) - b[1].atan2(b[0])).abs()
+}
+
+impl RoadNavigator {
+    /// Whether belief `b` puts the robot within `tolerance` of the goal node: before it, or
+    /// just past it after approaching it (a localizer update may move the belief onto the
+    /// next edge).
+    fn at_goal(&mut self, graph: &RoadGraph, b: RoadStart, tolerance: f64) -> bool {
+        if b.toward == self.goal {
+            self.goal_ahead = true;
+            return b.remaining <= tolerance;
+        }
+        self.goal_ahead
+            && other_end(graph, b.edge, b.toward) == self.goal
+            && graph.edges[b.edge].length - b.remaining <= tolerance
+    }
 }
 
 fn describe(mv: JunctionMove) -> String {

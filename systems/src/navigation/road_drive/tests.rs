@@ -66,6 +66,45 @@ fn plans_without_a_u_turn_replans_off_the_route_and_arrives() {
 }
 
 #[test]
+fn stops_at_the_goal_or_just_past_it_but_not_when_starting_past_it() {
+    let g = &park_fixture().0;
+    let none = |_: FollowSide| None;
+    let goal = id(g, "10");
+    let mut nav = RoadNavigator::new(goal, RoadNavParams::default());
+    let b = belief(g, "37", "19", 14.0);
+    let az = g.azimuth_from(b.edge, id(g, "37"));
+    nav.step(g, &input(0.0, Some(b), Some(az), &none));
+    let last = *nav.route.as_ref().unwrap().edges.last().unwrap();
+    // an edge on from the goal, off the route
+    let on = (0..g.edges.len())
+        .find(|&e| e != last && (g.edges[e].a == goal || g.edges[e].b == goal))
+        .unwrap();
+    let past = |by: f64| RoadStart {
+        edge: on,
+        toward: other_end(g, on, goal),
+        remaining: g.edges[on].length - by,
+    };
+    // 2 m before the goal the robot drives on (the default tolerance is 1 m)
+    let approach = RoadStart {
+        edge: last,
+        toward: goal,
+        remaining: 2.0,
+    };
+    let (v, _) = nav.step(g, &input(200.0, Some(approach), Some(az), &none));
+    assert!(v > 0.0 && nav.phase != RoadPhase::Arrived);
+    // an update moves the belief 0.5 m past the goal: there
+    nav.step(g, &input(201.0, Some(past(0.5)), Some(az), &none));
+    assert_eq!(nav.phase, RoadPhase::Arrived);
+
+    // a robot that starts just past the goal, leaving it, has not arrived
+    let mut nav = RoadNavigator::new(goal, RoadNavParams::default());
+    let start = past(0.5);
+    let az = g.azimuth_from(start.edge, goal);
+    nav.step(g, &input(0.0, Some(start), Some(az), &none));
+    assert_ne!(nav.phase, RoadPhase::Arrived);
+}
+
+#[test]
 fn the_map_leads_where_the_camera_disagrees_with_the_route() {
     let g = &park_fixture().0;
     let mut nav = RoadNavigator::new(id(g, "10"), RoadNavParams::default());
