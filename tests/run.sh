@@ -2,9 +2,9 @@
 # Runs every test of the workspace, in release mode.
 #
 # The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
-# the Python SDK's RrdReader) and Foxglove's Python MCAP readers (mcap, mcap-ros2-support); this
-# script installs them from PyPI into a virtual environment once (under $SIM_CACHE, default
-# ~/.cache/sim) and points the tests at it.
+# the Python SDK's RrdReader), Foxglove's Python MCAP readers (mcap, mcap-ros2-support) and evo
+# (evo_ape, evo_rpe); this script installs them from PyPI into virtual environments once (under
+# $SIM_CACHE, default ~/.cache/sim) and points the tests at them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -25,5 +25,16 @@ assert (v('mcap'), v('mcap-ros2-support')) == ('1.6.0', '0.6.0')" 2>/dev/null; t
         "mcap==1.6.0" "mcap-ros2-support==0.6.0"
 fi
 export SIM_RERUN_VENV="$venv"
+# evo, to score our TUM trajectories with its own evo_ape / evo_rpe (tests/check_evo.py); a
+# venv of its own so its numpy/matplotlib pins cannot move the rerun SDK's
+evo_venv="$cache/venv-evo-1.38.1"
+if ! "$evo_venv/bin/python" -c "from importlib.metadata import version as v
+assert v('evo') == '1.38.1'" 2>/dev/null; then
+    echo "setting up evo 1.38.1 in $evo_venv"
+    rm -rf "$evo_venv"
+    python3 -m venv "$evo_venv"
+    "$evo_venv/bin/pip" install --quiet --disable-pip-version-check "evo==1.38.1"
+fi
+export SIM_EVO_VENV="$evo_venv"
 
 cargo test --release --workspace

@@ -49,6 +49,17 @@ pub fn rerun_venv() -> PathBuf {
     }
 }
 
+/// evo 1.38.1 (`evo_ape`, `evo_rpe`): `$SIM_EVO_VENV` (set by tests/run.sh).
+pub fn evo_venv() -> PathBuf {
+    match std::env::var_os("SIM_EVO_VENV") {
+        Some(v) => PathBuf::from(v),
+        None => panic!(
+            "SIM_EVO_VENV is not set: run the tests with tests/run.sh, which installs evo \
+             1.38.1 in a virtual environment"
+        ),
+    }
+}
+
 pub fn repo_file(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }

@@ -348,3 +348,34 @@ fn grid_and_de_localizer_errors_name_the_key() {
         )));
     }
 }
+
+/// evo itself (the `evo_ape` / `evo_rpe` command-line tools, 1.38.1) scores the TUM files of
+/// `sim run --trajectories` and agrees with the summary's ATE and RPE to 1e-6 m (and rad).
+#[test]
+fn evo_agrees_with_our_ate_and_rpe() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut sc = load_scenario(&bundled("hospital_patrol")).unwrap();
+    sc.duration = 15.0;
+    sc.robots.truncate(1);
+    sc.robots[0]
+        .localizers
+        .retain(|l| l.name == "mcl" || l.name == "markov_grid");
+    assert_eq!(sc.robots[0].localizers.len(), 2);
+    let out = run(&sc);
+    let traj = dir.path().join("traj");
+    sim::record::write_trajectories(&traj, &out.localization).unwrap();
+    let summary = dir.path().join("summary.json");
+    std::fs::write(&summary, serde_json::to_string(&out.summary).unwrap()).unwrap();
+    let res = std::process::Command::new(evo_venv().join("bin/python"))
+        .arg(repo_file("check_evo.py"))
+        .args([&traj, &summary])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&res.stdout);
+    assert!(
+        res.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&res.stderr)
+    );
+    assert!(text.contains("8 passed, 0 failed"), "{text}");
+}
