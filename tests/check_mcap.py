@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Cross-checks an MCAP file written by the simulator with Foxglove's own Python readers.
 
-Usage: check_mcap.py FILE.mcap COUNTS.json [--values VALUES.json]
+Usage: check_mcap.py FILE.mcap COUNTS.json [--values VALUES.json] [--rates TOPIC=HZ]...
 
 COUNTS.json maps each topic to its expected message count. Every message is decoded with
 mcap-ros2-support (`mcap_ros2.reader.read_ros2_messages`, from the schema text in the file):
@@ -9,7 +9,8 @@ the counts must match and no message may fail to decode. Each decoded message is
 again from the same schema and must give back the stored CDR bytes exactly (so field order,
 types, alignment and the encapsulation header all agree). With --values (topic -> list of the
 messages as JSON, in log-time order, as the Rust test writes them), every field's name, order
-and value must match too.
+and value must match too. With --rates, the mean rate of each named topic, (n - 1) / (last log
+time - first log time), must be within 2 % of HZ. A topic counted 0 must have no messages.
 
 Needs: pip install mcap==1.6.0 mcap-ros2-support==0.6.0 (tests/run.sh installs them).
 Exits 0 and prints "N passed, 0 failed" on success.
@@ -51,7 +52,12 @@ def main():
     parser.add_argument("mcap")
     parser.add_argument("counts")
     parser.add_argument("--values")
+    parser.add_argument("--rates", action="append", default=[], metavar="TOPIC=HZ")
     args = parser.parse_args()
+    rates = {}
+    for spec in args.rates:
+        topic, _, hz = spec.rpartition("=")
+        rates[topic] = float(hz)
     with open(args.counts) as f:
         expected_counts = json.load(f)
     expected_values = None
@@ -87,7 +93,7 @@ def main():
     check("header", header)
 
     # 2. Counts and decoding with the high-level API, in log-time order.
-    counts, decoded = Counter(), {}
+    counts, decoded, times = Counter(), {}, {}
 
     def decode_all():
         last = -1
@@ -96,11 +102,17 @@ def main():
             last = m.log_time_ns
             counts[m.channel.topic] += 1
             decoded.setdefault(m.channel.topic, []).append(m.ros_msg)
+            times.setdefault(m.channel.topic, []).append(m.log_time_ns)
 
     check("decode every message", decode_all)
     for topic, n in expected_counts.items():
         check(f"count {topic}", lambda t=topic, n=n: _eq(counts[t], n))
-    check("no other topics", lambda: _eq(sorted(counts), sorted(expected_counts)))
+    check(
+        "no other topics",
+        lambda: _eq(sorted(counts), sorted(t for t, n in expected_counts.items() if n)),
+    )
+    for topic, hz in rates.items():
+        check(f"rate {topic}", lambda t=topic, hz=hz: _rate(times.get(t, []), hz))
 
     # 3. Decode then encode again: the stored bytes come back.
     def reencode():
@@ -137,6 +149,12 @@ def main():
 
 def _eq(got, want):
     assert got == want, f"{got!r} != {want!r}"
+
+
+def _rate(times_ns, hz):
+    assert len(times_ns) >= 2, f"{len(times_ns)} messages: no rate"
+    mean = (len(times_ns) - 1) / ((times_ns[-1] - times_ns[0]) * 1e-9)
+    assert abs(mean - hz) <= 0.02 * hz, f"mean rate {mean:.4f} Hz, expected {hz} Hz"
 
 
 if __name__ == "__main__":

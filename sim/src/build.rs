@@ -49,8 +49,29 @@ impl SimWorld {
     }
 }
 
+/// What the world is built for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildMode {
+    /// A simulation: every plugin.
+    Live,
+    /// Estimators fed with recorded readings ([`crate::replay`]): the robots with their
+    /// sensors' descriptions, odometry, localizers and SLAM systems, the script and the
+    /// evaluation; no navigation, people, physics steps, sensor sampling or outdoor parts.
+    Replay,
+}
+
 /// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
 pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
+    build_world_with(scenario, threads, BuildMode::Live)
+}
+
+/// [`build_world`] for a live run or a replay.
+pub fn build_world_with(
+    scenario: &Scenario,
+    threads: usize,
+    mode: BuildMode,
+) -> anyhow::Result<SimWorld> {
+    let live = mode == BuildMode::Live;
     let mut world = World::new();
     let pool = KernelPool::new(threads)
         .map_err(|e| anyhow::anyhow!("cannot start {threads} kernel threads: {e}"))?;
@@ -62,6 +83,7 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
     let nav_params: Vec<_> = scenario
         .robots
         .iter()
+        .filter(|_| live)
         .filter_map(|r| r.navigation.as_ref().map(|n| n.costmap))
         .collect();
     let costmaps = (!nav_params.is_empty()).then(|| NavCostmaps::new(&static_world, &nav_params));
@@ -86,12 +108,16 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
         world.insert_resource(LocalizationMap::new(scenario.grid.clone(), max_dist));
     }
 
-    crate::build_outdoor::insert_outdoor_world(&mut world, scenario);
+    if live {
+        crate::build_outdoor::insert_outdoor_world(&mut world, scenario);
+    }
     let mut robots = Vec::with_capacity(scenario.robots.len());
     for (i, r) in scenario.robots.iter().enumerate() {
         let body = physics.add_robot(i as u32, &r.start, &r.footprint);
         let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body)?;
-        crate::build_outdoor::insert_outdoor_parts(&mut world, scenario.seed, e, r);
+        if live {
+            crate::build_outdoor::insert_outdoor_parts(&mut world, scenario.seed, e, r);
+        }
         if let (Some(nav), Some(maps)) = (&r.navigation, &costmaps) {
             let mut params = nav.params.clone();
             params.costmap = maps.index_of(&nav.costmap).unwrap_or(0);
@@ -125,15 +151,18 @@ pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWor
 
     let mut schedule = new_schedule();
     schedule.add_systems(fire_events.in_set(SimSet::Script));
-    let plugins: [&dyn SimPlugin; 7] = [
-        &NavigationPlugin,
-        &PeoplePlugin,
-        &PhysicsPlugin,
-        &SensorsPlugin,
-        &LocalizationPlugin,
-        &MappingPlugin,
-        &EvalPlugin,
-    ];
+    let plugins: &[&dyn SimPlugin] = match mode {
+        BuildMode::Live => &[
+            &NavigationPlugin,
+            &PeoplePlugin,
+            &PhysicsPlugin,
+            &SensorsPlugin,
+            &LocalizationPlugin,
+            &MappingPlugin,
+            &EvalPlugin,
+        ],
+        BuildMode::Replay => &[&LocalizationPlugin, &MappingPlugin, &EvalPlugin],
+    };
     for p in plugins {
         p.build(&mut world, &mut schedule);
     }

@@ -4,12 +4,14 @@ use clap::{Parser, Subcommand};
 use sim::bench::{SwarmOptions, run_swarm_bench};
 use sim::bench_loc::{LocBenchOptions, run_markov_grid_bench, run_mcl_bench};
 use sim::bench_match::{DeMatchBenchOptions, run_de_match_bench};
+use sim::bench_record::{RecordBenchOptions, run_record_bench};
 use sim::bench_slam::{SlamBenchOptions, run_slam_bench};
 use sim::experiment::de_match::{DeMatchOptions, run_de_match_experiment};
 use sim::experiment::slam_compare::{
     METHODS as SLAM_METHODS, SCENARIOS as SLAM_SCENARIOS, SlamExperimentOptions,
     run_slam_experiment, table as slam_table,
 };
+use sim::interrupt::Interrupted;
 use sim::match_cmd::{CrossoverArg, FitnessArg, MatchOptions, parse_strategy, run_match};
 use sim::run_cmd::{RunArgs, check_duration, run_command, scenario_arg};
 use sim::runner::ScanCapture;
@@ -33,6 +35,15 @@ struct Cli {
 enum Command {
     /// Run a scenario (a file, or the name of a bundled scenario; default: hospital_patrol).
     Run(RunArgs),
+    /// Run a scenario for many seeds and parameter sets in parallel; one row per run
+    /// (runs.csv, runs.jsonl) and statistics per set (aggregate.csv, printed). Exit code 2 if
+    /// any run failed.
+    Batch(sim::batch::BatchArgs),
+    /// Merge the output folders of the shards of one batch (`sim batch --shard k/n`) into one.
+    BatchMerge(sim::batch::merge::MergeArgs),
+    /// Re-run localization, SLAM and evaluation on the sensor data of an MCAP file (one written
+    /// by `sim run --mcap`, or LaserScan + Odometry of another ROS 2 system with --scenario).
+    Replay(sim::replay::ReplayArgs),
     /// Run a SLAM system on a recorded CARMEN log (e.g. one written by `sim run --carmen-out`).
     Slam(SlamArgs),
     /// List the bundled scenarios.
@@ -130,6 +141,28 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// Run time with no recording, with the .rrd, with the MCAP replay and with both (median
+    /// of --reps runs each), and the overhead of each against no recording.
+    Record {
+        /// One JSON object per scenario and mode, one per line.
+        #[arg(long)]
+        json: bool,
+        /// Scenarios: bundled names or paths.
+        #[arg(long = "scenario", value_delimiter = ',', default_values_t = sim::bench_record::SCENARIOS.map(String::from))]
+        scenarios: Vec<String>,
+        /// Runs per mode (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        reps: usize,
+        /// Simulated seconds per run (default: 10 s of hospital_patrol, a scenario's own
+        /// duration otherwise).
+        #[arg(long, allow_negative_numbers = true)]
+        duration: Option<f64>,
+        /// Kernel threads (0 = one per core).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+    },
+    /// Wall time of a batch with --jobs 1 --threads 1 and with --jobs 2, and the speed-up.
+    Batch(sim::bench_batch::BenchBatchArgs),
     /// Real-time factor and rays/s for swarms of wandering robots with lasers at 10 Hz.
     Swarm {
         /// One JSON object per population and laser, one per line.
@@ -281,16 +314,35 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.is::<Interrupted>() => {
+            eprintln!("{e}");
+            ExitCode::from(sim::interrupt::EXIT_CODE)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
-            ExitCode::FAILURE
+            if e.is::<sim::batch::RunsFailed>() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::FAILURE
+            }
         }
     }
 }
 
 fn dispatch(cmd: Command) -> anyhow::Result<()> {
     match cmd {
-        Command::Run(args) => run_command(&args),
+        Command::Run(args) => {
+            sim::interrupt::install_handler()?;
+            run_command(&args)
+        }
+        Command::Batch(args) => sim::batch::batch_command(&args)?.into_result().map(|_| ()),
+        Command::BatchMerge(args) => sim::batch::merge::merge_command(&args)?
+            .into_result()
+            .map(|_| ()),
+        Command::Replay(args) => {
+            sim::interrupt::install_handler()?;
+            sim::replay::replay_command(&args)
+        }
         Command::Slam(args) => run_slam_command(&args).map(|_| ()),
         Command::Scenarios => {
             for (name, path) in bundled_scenarios() {
@@ -457,6 +509,21 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
             }
         },
         Command::Bench { which } => match which {
+            BenchCommand::Record {
+                json,
+                scenarios,
+                reps,
+                duration,
+                threads,
+            } => run_record_bench(&RecordBenchOptions {
+                json,
+                scenarios,
+                reps,
+                duration,
+                threads,
+            })
+            .map(|_| ()),
+            BenchCommand::Batch(args) => sim::bench_batch::run_batch_bench(&args).map(|_| ()),
             BenchCommand::Swarm {
                 json,
                 robots,

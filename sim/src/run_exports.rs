@@ -1,10 +1,12 @@
 //! Files a run exports besides the recording, on request: CARMEN logs (`--carmen-out`,
-//! [`crate::carmen_out`]) and maps (`--save-map`, [`crate::map_out`]). Both are observers in
-//! the Record set: they never change what the run computes.
+//! [`crate::carmen_out`]), maps (`--save-map`, [`crate::map_out`]) and an MCAP replay
+//! (`--mcap`, [`crate::mcap_out`]). All are observers in the Record set: they never change what
+//! the run computes.
 
 use crate::build::SimWorld;
 use crate::carmen_out::{CarmenExport, record_carmen};
 use crate::map_out::{KnownPoseMaps, SavedMap, map_known_poses, run_maps, save_maps};
+use crate::mcap_out::{McapExport, McapWritten, record_mcap};
 use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
 use std::path::PathBuf;
@@ -17,6 +19,8 @@ pub struct RunExports {
     pub carmen_out: Option<PathBuf>,
     /// Save the maps here (see [`crate::map_out`]).
     pub save_map: Option<PathBuf>,
+    /// Write an MCAP replay of ROS 2 messages here (see [`crate::mcap_out`]).
+    pub mcap: Option<PathBuf>,
 }
 
 /// What was exported.
@@ -24,6 +28,7 @@ pub struct RunExports {
 pub struct Exported {
     pub carmen_logs: Vec<PathBuf>,
     pub maps: Vec<SavedMap>,
+    pub mcap: Option<McapWritten>,
 }
 
 impl RunExports {
@@ -40,6 +45,11 @@ impl RunExports {
             sim.schedule
                 .add_systems(map_known_poses.in_set(SimSet::Record));
         }
+        if let Some(path) = &self.mcap {
+            let export = McapExport::new(&mut sim.world, scenario, path)?;
+            sim.world.insert_resource(export);
+            sim.schedule.add_systems(record_mcap.in_set(SimSet::Record));
+        }
         Ok(())
     }
 
@@ -53,6 +63,9 @@ impl RunExports {
         let mut done = Exported::default();
         if let Some(export) = world.remove_resource::<CarmenExport>() {
             done.carmen_logs = export.save()?;
+        }
+        if let Some(export) = world.remove_resource::<McapExport>() {
+            done.mcap = Some(export.finish()?);
         }
         if let Some(path) = &self.save_map {
             let maps = run_maps(world);

@@ -1,5 +1,8 @@
 //! The run loop: steps the schedule for the scenario's duration as fast as the CPU allows, shows
-//! progress (simulated time and real-time factor), records, and gathers the summary.
+//! progress (simulated time and real-time factor), records, and gathers the summary. A stop
+//! asked for by Ctrl-C or SIGTERM ([`crate::interrupt`]) ends the loop after the current tick;
+//! the recordings and exports are then finished as after the last tick, and the summary covers
+//! the ticks run.
 
 use crate::build::{SimWorld, build_world};
 use crate::record::outdoor::{OutdoorRecording, record_outdoor};
@@ -65,6 +68,9 @@ pub struct RunOutput {
     pub log: Vec<(f64, String, String)>,
     /// The files [`run_scenario_exporting`] wrote.
     pub exported: Exported,
+    /// The run was stopped by Ctrl-C or SIGTERM before its end (`summary.sim_time_s` says
+    /// where).
+    pub interrupted: bool,
 }
 
 /// True when the scenario asks to end once every robot with tasks is done, and they are.
@@ -234,12 +240,32 @@ fn run(
     capture: Option<&ScanCapture>,
     exports: &RunExports,
 ) -> anyhow::Result<RunOutput> {
+    let sim = build_world(scenario, opts.threads)?;
+    run_world(sim, scenario, opts, capture, exports)
+}
+
+/// Runs a world built from `scenario` (e.g. a replay's) to the scenario's end, as a run does.
+pub fn run_built(
+    sim: SimWorld,
+    scenario: &Scenario,
+    opts: &RunOptions,
+    exports: &RunExports,
+) -> anyhow::Result<RunOutput> {
+    run_world(sim, scenario, opts, None, exports)
+}
+
+fn run_world(
+    mut sim: SimWorld,
+    scenario: &Scenario,
+    opts: &RunOptions,
+    capture: Option<&ScanCapture>,
+    exports: &RunExports,
+) -> anyhow::Result<RunOutput> {
     let mut capturer = capture.map(|capture| Capturer {
         capture,
         next: Vec::new(),
         scans: Vec::new(),
     });
-    let mut sim: SimWorld = build_world(scenario, opts.threads)?;
     if let Some(path) = &opts.rrd {
         let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
         sim.world.insert_resource(rec);
@@ -277,7 +303,13 @@ fn run(
     let mut next_sample = 0.0;
     let update_every = (ticks / 500).max(1);
     let mut ticks_run = ticks;
+    let mut interrupted = false;
     for tick in 0..ticks {
+        if crate::interrupt::requested() {
+            interrupted = true;
+            ticks_run = tick;
+            break;
+        }
         if let Some(period) = opts.trajectory_period {
             let t = sim.time();
             if t + 1e-9 >= next_sample {
@@ -333,6 +365,7 @@ fn run(
         scans: capturer.map(|c| c.scans).unwrap_or_default(),
         log: event_log(&mut sim.world),
         exported,
+        interrupted,
     })
 }
 

@@ -137,7 +137,7 @@ pub fn simulate(
     }
     let exports = RunExports {
         carmen_out: Some(out.clone()),
-        save_map: None,
+        ..Default::default()
     };
     let opts = RunOptions {
         threads: o.threads,

@@ -1,7 +1,9 @@
 //! The `sim` command line: exit codes, error messages, default file names, the summary JSON.
 
 mod carmen;
+mod interrupt;
 mod matching;
+mod replay;
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -113,7 +115,7 @@ fn no_rrd_writes_nothing_and_prints_the_table() {
     assert_eq!(rrds, 0);
 }
 
-fn expect_failure(args: &[&str], cwd: &Path, fragments: &[&str]) {
+pub fn expect_failure(args: &[&str], cwd: &Path, fragments: &[&str]) {
     let out = sim(args, cwd);
     assert!(!out.status.success(), "{args:?} should fail");
     let err = String::from_utf8_lossy(&out.stderr);

@@ -78,8 +78,22 @@ impl WheelOdometry {
         self.trail.push((stamp, self.pose));
     }
 
+    /// The poses integrated in the current tick, after the last one of the previous tick
+    /// (`(stamp, pose)` in time order): every odometry update, for recorders.
+    pub fn trail(&self) -> &[(f64, Pose2)] {
+        &self.trail
+    }
+
+    /// Takes a pose measured by another odometry (a replayed nav_msgs/Odometry) instead of
+    /// integrating encoder ticks.
+    pub fn set_pose(&mut self, pose: Pose2, stamp: f64) {
+        self.pose = pose;
+        self.stamp = stamp;
+        self.trail.push((stamp, pose));
+    }
+
     /// Keeps only the latest pose of the trail (called at the start of each tick).
-    fn start_tick(&mut self) {
+    pub fn start_tick(&mut self) {
         let keep = self.trail.len().saturating_sub(1);
         self.trail.drain(..keep);
     }

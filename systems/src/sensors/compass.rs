@@ -2,7 +2,10 @@
 //! under 1° in the open, by 8–20° near electromagnetic interference). A reading is the true
 //! heading as a compass azimuth (clockwise from north; magnetic north is taken as true north)
 //! plus a constant bias, Gaussian noise and the deflection of the interference zone the robot is
-//! in ([`crate::world::Zones`]). Recorded like the orientation of a sensor_msgs/Imu.
+//! in ([`crate::world::Zones`]). Recorded like the orientation of a sensor_msgs/Imu: a reading
+//! carries that quaternion and its azimuth is computed from it, so a replay that rebuilds the
+//! reading from a recorded message ([`CompassReading::from_orientation`]) gets the same azimuth
+//! bit for bit (DESIGN.md: estimators consume readings shaped like their ROS messages).
 
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;
@@ -12,6 +15,7 @@ use crate::world::zones::Zones;
 use bevy_ecs::prelude::*;
 use rand::RngExt;
 use rand_distr::StandardNormal;
+use std::f64::consts::{FRAC_PI_2, TAU};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompassSpec {
@@ -35,10 +39,36 @@ impl Default for CompassSpec {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CompassReading {
     pub stamp: f64,
-    /// Compass azimuth (radians clockwise from north, [0, 2π)).
+    /// Compass azimuth (radians clockwise from north, [0, 2π)), computed from `orientation`.
     pub azimuth: f64,
     /// Variance the sensor states (rad²): its noise only; it cannot know about interference.
     pub variance: f64,
+    /// The heading as the orientation quaternion `[x, y, z, w]` of a sensor_msgs/Imu in the
+    /// ENU world frame (REP 103/145: yaw counter-clockwise from east, π/2 − azimuth).
+    pub orientation: [f64; 4],
+}
+
+impl CompassReading {
+    /// The reading whose orientation quaternion is `orientation` (only its yaw is used).
+    pub fn from_orientation(stamp: f64, orientation: [f64; 4], variance: f64) -> Self {
+        let yaw = 2.0 * orientation[2].atan2(orientation[3]);
+        let azimuth = (FRAC_PI_2 - yaw).rem_euclid(TAU);
+        CompassReading {
+            stamp,
+            // rem_euclid of a tiny negative angle rounds up to 2π itself
+            azimuth: if azimuth >= TAU { 0.0 } else { azimuth },
+            variance,
+            orientation,
+        }
+    }
+}
+
+/// The ENU orientation quaternion `[x, y, z, w]` of a compass azimuth (radians clockwise from
+/// north): a rotation about z by the heading π/2 − azimuth.
+pub fn orientation_of_azimuth(azimuth: f64) -> [f64; 4] {
+    let yaw = crate::core::wrap_angle(FRAC_PI_2 - azimuth);
+    let (s, c) = (yaw / 2.0).sin_cos();
+    [0.0, 0.0, s, c]
 }
 
 #[derive(Component, Clone, Debug)]
@@ -65,11 +95,12 @@ impl Compass {
         let n: f64 = self.rng.sample(StandardNormal);
         let truth = azimuth_of([theta.cos(), theta.sin()]);
         let err = (self.spec.bias_deg + self.spec.noise_std_deg * n).to_radians() + deflection;
-        CompassReading {
+        let azimuth = (truth + err).rem_euclid(TAU);
+        CompassReading::from_orientation(
             stamp,
-            azimuth: (truth + err).rem_euclid(std::f64::consts::TAU),
-            variance: self.spec.noise_std_deg.to_radians().powi(2),
-        }
+            orientation_of_azimuth(azimuth),
+            self.spec.noise_std_deg.to_radians().powi(2),
+        )
     }
 }
 
@@ -111,6 +142,26 @@ mod tests {
 
     fn angle_diff_deg(a: f64, b: f64) -> f64 {
         crate::core::wrap_angle(a - b).to_degrees()
+    }
+
+    #[test]
+    fn a_reading_rebuilt_from_its_quaternion_is_identical() {
+        let mut c = Compass::new(CompassSpec::default(), stream_rng(2, "c", "compass"));
+        for k in 0..5000 {
+            let theta = -3.2 + k as f64 * 0.00128;
+            let r = c.read(k as f64, theta, 0.0);
+            assert!((0.0..TAU).contains(&r.azimuth), "{}", r.azimuth);
+            let raw = azimuth_of([theta.cos(), theta.sin()]);
+            assert!(angle_diff_deg(r.azimuth, raw).abs() < 3.0, "{theta}");
+            let again = CompassReading::from_orientation(r.stamp, r.orientation, r.variance);
+            assert_eq!(again, r);
+            assert_eq!(again.azimuth.to_bits(), r.azimuth.to_bits());
+        }
+        // the quaternion is the ENU heading: azimuth 90° (east) is yaw 0
+        let east = orientation_of_azimuth(FRAC_PI_2);
+        assert!(east[2].abs() < 1e-15 && (east[3] - 1.0).abs() < 1e-15);
+        let r = CompassReading::from_orientation(0.0, orientation_of_azimuth(0.0), 0.0);
+        assert!(r.azimuth.abs() < 1e-12 || (TAU - r.azimuth) < 1e-12);
     }
 
     #[test]

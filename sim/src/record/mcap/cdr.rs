@@ -59,6 +59,22 @@ pub fn encode_into<T: Serialize>(out: &mut Vec<u8>, msg: &T) {
 /// Decodes a CDR payload (either byte order). Up to 3 bytes may follow the message (the
 /// padding to a multiple of 4 that some rmw layers add); more means a type mismatch.
 pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CdrError> {
+    let (msg, used, total) = decode_front(bytes)?;
+    let left = total - used;
+    if left > 3 {
+        return Err(CdrError::TrailingBytes { left, used, total });
+    }
+    Ok(msg)
+}
+
+/// Decodes the leading fields of a payload as `T` and ignores the rest: e.g. the
+/// `std_msgs/Header` that every stamped message starts with.
+pub fn decode_prefix<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CdrError> {
+    decode_front(bytes).map(|(msg, ..)| msg)
+}
+
+/// `T` from the front of the body: (message, bytes used, body length).
+fn decode_front<T: DeserializeOwned>(bytes: &[u8]) -> Result<(T, usize, usize), CdrError> {
     let Some(body) = bytes.get(4..) else {
         return Err(CdrError::TooShort(bytes.len()));
     };
@@ -67,15 +83,7 @@ pub fn decode<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, CdrError> {
         (0x00, 0x00) => cdr_encoding::from_bytes::<T, BigEndian>(body)?,
         (a, b) => return Err(CdrError::Encapsulation(a, b)),
     };
-    let left = body.len() - used;
-    if left > 3 {
-        return Err(CdrError::TrailingBytes {
-            left,
-            used,
-            total: body.len(),
-        });
-    }
-    Ok(msg)
+    Ok((msg, used, body.len()))
 }
 
 #[cfg(test)]

@@ -27,6 +27,8 @@ fn every_type_round_trips() {
     round_trip(&samples::imu(2.0));
     round_trip(&samples::image(2.0, 320, 240));
     round_trip(&samples::range(2.0));
+    round_trip(&samples::joint_state(2.0));
+    round_trip(&JointState::default());
     round_trip(&Header::default());
     round_trip(&TFMessage::default());
 }

@@ -143,6 +143,16 @@ pub fn range(t: f64) -> Range {
     }
 }
 
+pub fn joint_state(t: f64) -> JointState {
+    JointState {
+        header: header(t, "base_link"),
+        name: vec!["left_wheel_joint".into(), "right_wheel_joint".into()],
+        position: vec![12.5 + t, -3.25],
+        velocity: vec![0.5, 0.25],
+        effort: Vec::new(),
+    }
+}
+
 /// Writes every message type on its own topic (`/scan` twice as often, times interleaved);
 /// returns the topic → count table.
 pub fn write_all_types(rec: &mut McapRecorder, seconds: u64) -> Vec<(&'static str, usize)> {
@@ -155,6 +165,7 @@ pub fn write_all_types(rec: &mut McapRecorder, seconds: u64) -> Vec<(&'static st
     let imu = rec.channel::<Imu>("/imu").unwrap();
     let cam = rec.channel::<Image>("/camera/image_raw").unwrap();
     let sonar = rec.channel::<Range>("/sonar/0").unwrap();
+    let joints = rec.channel::<JointState>("/joint_states").unwrap();
     for s in 0..seconds {
         let t = s as f64;
         let ns = s * SEC;
@@ -170,6 +181,7 @@ pub fn write_all_types(rec: &mut McapRecorder, seconds: u64) -> Vec<(&'static st
         rec.write(imu, ns, &self::imu(t)).unwrap();
         rec.write(cam, ns, &image(t, 320, 240)).unwrap();
         rec.write(sonar, ns, &range(t)).unwrap();
+        rec.write(joints, ns, &joint_state(t)).unwrap();
     }
     let n = seconds as usize;
     vec![
@@ -182,6 +194,7 @@ pub fn write_all_types(rec: &mut McapRecorder, seconds: u64) -> Vec<(&'static st
         ("/imu", n),
         ("/camera/image_raw", n),
         ("/sonar/0", n),
+        ("/joint_states", n),
     ]
 }
 
@@ -237,6 +250,7 @@ fn write_sample(path: &std::path::Path) {
                 "sensor_msgs/msg/Imu" => json(r.decode::<Imu>(m)),
                 "sensor_msgs/msg/Image" => json(r.decode::<Image>(m)),
                 "sensor_msgs/msg/Range" => json(r.decode::<Range>(m)),
+                "sensor_msgs/msg/JointState" => json(r.decode::<JointState>(m)),
                 other => panic!("no sample of {other}"),
             })
             .collect();

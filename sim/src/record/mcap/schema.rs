@@ -104,6 +104,10 @@ macro_rules! msg {
         "std_msgs/Header header\nuint8 ULTRASOUND=0\nuint8 INFRARED=1\nuint8 radiation_type\n\
          float32 field_of_view\nfloat32 min_range\nfloat32 max_range\nfloat32 range"
     };
+    (JointState) => {
+        "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n\
+         float64[] effort"
+    };
     (TFMessage) => {
         "geometry_msgs/TransformStamped[] transforms"
     };
@@ -149,6 +153,7 @@ ros_message!(Imu, "sensor_msgs",
     "geometry_msgs" Quaternion, "geometry_msgs" Vector3);
 ros_message!(Image, "sensor_msgs", "std_msgs" Header, "builtin_interfaces" Time);
 ros_message!(Range, "sensor_msgs", "std_msgs" Header, "builtin_interfaces" Time);
+ros_message!(JointState, "sensor_msgs", "std_msgs" Header, "builtin_interfaces" Time);
 
 #[cfg(test)]
 #[path = "schema_tests.rs"]

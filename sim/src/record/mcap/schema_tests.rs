@@ -82,6 +82,7 @@ fn every_schema_is_complete() {
     check::<Imu>();
     check::<Image>();
     check::<Range>();
+    check::<JointState>();
 }
 
 #[test]

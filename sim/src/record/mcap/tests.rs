@@ -19,7 +19,7 @@ fn written(dir: &Path, seconds: u64) -> (PathBuf, Vec<(&'static str, usize)>) {
         stats.messages as usize,
         counts.iter().map(|c| c.1).sum::<usize>()
     );
-    assert_eq!((stats.channels, stats.attachments), (9, 1));
+    assert_eq!((stats.channels, stats.attachments), (10, 1));
     (path, counts)
 }
 
@@ -75,6 +75,10 @@ fn several_channels_read_back_in_time_order() {
     assert_eq!(
         r.decode_topic::<Range>("/sonar/0").unwrap()[1].1,
         samples::range(1.0)
+    );
+    assert_eq!(
+        r.decode_topic::<JointState>("/joint_states").unwrap()[2].1,
+        samples::joint_state(2.0)
     );
     // The wrong type is a clear error.
     let e = r.decode_topic::<Imu>("/scan").unwrap_err().to_string();

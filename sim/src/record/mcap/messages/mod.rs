@@ -20,7 +20,7 @@ pub use geometry_msgs::{
     TwistWithCovariance, Vector3,
 };
 pub use nav_msgs::Odometry;
-pub use sensor_msgs::{Image, Imu, LaserScan, NavSatFix, NavSatStatus, Range};
+pub use sensor_msgs::{Image, Imu, JointState, LaserScan, NavSatFix, NavSatStatus, Range};
 pub use std_msgs::{Header, Time};
 pub use tf2_msgs::TFMessage;
 

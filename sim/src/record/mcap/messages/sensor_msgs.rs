@@ -1,5 +1,5 @@
 //! `sensor_msgs/msg/*` (ros2/common_interfaces `sensor_msgs/msg/*.msg`, Humble/Jazzy): laser
-//! scans, satellite fixes, IMU readings, raw images and single-beam rangers.
+//! scans, satellite fixes, IMU readings, raw images, single-beam rangers and joint states.
 
 use super::geometry_msgs::{Quaternion, Vector3};
 use super::std_msgs::Header;
@@ -116,4 +116,15 @@ pub struct Range {
 impl Range {
     pub const ULTRASOUND: u8 = 0;
     pub const INFRARED: u8 = 1;
+}
+
+/// `sensor_msgs/msg/JointState`: named joints with position (rad or m), velocity and effort;
+/// each array is either empty or as long as `name`.
+#[derive(Serialize, Deserialize, Debug, Clone, PartialEq, Default)]
+pub struct JointState {
+    pub header: Header,
+    pub name: Vec<String>,
+    pub position: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub effort: Vec<f64>,
 }

@@ -1,0 +1,308 @@
+//! `sim batch`: many seeded runs of a scenario, with parameter sets made of `--set`, `--sweep`
+//! and `--zip` overrides, in parallel on a pool of `--jobs` workers. Each run is isolated and
+//! deterministic (same set and seed ⇒ same summary, whatever `--jobs` and `--threads`); a set
+//! that fails to load or a run that fails is reported and counted, and the others go on. Writes
+//! `runs.csv`, `runs.jsonl` (one row per run, every summary metric) and `aggregate.csv`
+//! (mean, std, median, p95 per set and metric), and prints the table of the main metrics.
+//! `sim batch-merge` ([`merge`]) joins the outputs of the shards of one batch.
+
+pub mod aggregate;
+pub mod args;
+pub mod merge;
+pub mod output;
+pub mod params;
+pub mod runner;
+pub mod sets;
+#[cfg(test)]
+mod tests_params;
+
+pub use args::BatchArgs;
+
+use crate::run_cmd::{check_duration, scenario_path};
+use crate::runner::{RunOptions, run_scenario};
+use crate::scenario::Scenario;
+use crate::summary::Summary;
+use output::Row;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What a batch did.
+#[derive(Debug)]
+pub struct BatchReport {
+    pub out_dir: PathBuf,
+    /// Runs of this shard (or of the whole batch).
+    pub runs: usize,
+    pub failed: usize,
+    /// One row per run, in job order (as in runs.csv).
+    pub rows: Vec<Row>,
+    /// The printed aggregate table.
+    pub table: String,
+    pub wall_s: f64,
+}
+
+/// The error of a batch whose files were written but some of whose runs failed (exit code 2).
+#[derive(Debug)]
+pub struct RunsFailed {
+    pub failed: usize,
+    pub runs: usize,
+    pub out_dir: PathBuf,
+}
+
+impl std::fmt::Display for RunsFailed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} runs failed (the files in {} hold every run, with its status)",
+            self.failed,
+            self.runs,
+            self.out_dir.display()
+        )
+    }
+}
+
+impl std::error::Error for RunsFailed {}
+
+impl BatchReport {
+    /// Ok if every run succeeded, else [`RunsFailed`].
+    pub fn into_result(self) -> anyhow::Result<BatchReport> {
+        if self.failed > 0 {
+            return Err(RunsFailed {
+                failed: self.failed,
+                runs: self.runs,
+                out_dir: self.out_dir,
+            }
+            .into());
+        }
+        Ok(self)
+    }
+}
+
+/// What to run, parsed and loaded: parameter sets with their scenarios, and this shard's jobs.
+pub struct Batch {
+    pub name: String,
+    pub keys: Vec<String>,
+    pub sets: Vec<Vec<params::Override>>,
+    /// Per set, its scenario (None: no job of this shard uses it).
+    pub scenarios: Vec<Option<Result<Scenario, String>>>,
+    pub jobs: Vec<runner::Job>,
+}
+
+/// Parses the arguments and loads every parameter set a job of the shard uses; fails if the
+/// arguments are bad or no set loads.
+pub fn prepare(a: &BatchArgs) -> anyhow::Result<Batch> {
+    let seeds = args::parse_seeds(&a.seeds)?;
+    let shard = a.shard.as_deref().map(args::parse_shard).transpose()?;
+    let plan = sets::plan_sets(&a.sets, &a.sweeps, &a.zips)?;
+    let source = sets::Source::load(&scenario_path(Some(&a.scenario))?)?;
+    let duration = a.duration.map(check_duration).transpose()?;
+    let jobs = runner::plan_jobs(plan.sets.len(), seeds, shard);
+    let scenarios: Vec<Option<Result<Scenario, String>>> = (0..plan.sets.len())
+        .map(|i| {
+            jobs.iter().any(|j| j.set == i).then(|| {
+                source.scenario(&plan.sets[i]).map(|mut s| {
+                    if let Some(d) = duration {
+                        s.duration = d;
+                    }
+                    s
+                })
+            })
+        })
+        .collect();
+    let errors: Vec<(usize, &String)> = scenarios
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| Some((i, s.as_ref()?.as_ref().err()?)))
+        .collect();
+    let loaded = scenarios.iter().flatten().count();
+    if loaded > 0 && errors.len() == loaded {
+        if let [(_, e)] = errors.as_slice() {
+            anyhow::bail!("{e}");
+        }
+        let list: Vec<String> = errors
+            .iter()
+            .map(|(i, e)| format!("  set {i}: {e}"))
+            .collect();
+        anyhow::bail!("no parameter set loads:\n{}", list.join("\n"));
+    }
+    Ok(Batch {
+        name: source.plain.name.clone(),
+        keys: plan.keys,
+        sets: plan.sets,
+        scenarios,
+        jobs,
+    })
+}
+
+fn default_out(a: &BatchArgs, name: &str) -> PathBuf {
+    let seeds = a.seeds.replace("..", "-");
+    let shard = match a.shard.as_deref().and_then(|s| args::parse_shard(s).ok()) {
+        Some((k, n)) => format!("-shard{k}of{n}"),
+        None => String::new(),
+    };
+    PathBuf::from(format!("batch-{name}-{seeds}{shard}"))
+}
+
+fn describe_set(b: &Batch, set: usize) -> String {
+    let p: Vec<String> = b.sets[set]
+        .iter()
+        .filter(|o| o.flag != "--set")
+        .map(|o| format!("{}={}", o.key, o.text))
+        .collect();
+    if p.is_empty() {
+        format!("set {set}")
+    } else {
+        format!("set {set} ({})", p.join(" "))
+    }
+}
+
+/// Runs the batch's jobs: the summaries (or errors) in job order, with wall times.
+pub fn run_batch(
+    b: &Batch,
+    workers: usize,
+    threads: usize,
+    rrd_dir: Option<&Path>,
+    show_progress: bool,
+) -> anyhow::Result<Vec<runner::Finished<Summary>>> {
+    let bar = runner::progress_bar(b.jobs.len(), show_progress);
+    let mut failed = Vec::new();
+    let mut runnable = Vec::new();
+    for (set, s) in b.scenarios.iter().enumerate() {
+        if let Some(Err(e)) = s {
+            let n = b.jobs.iter().filter(|j| j.set == set).count();
+            eprintln!(
+                "{} does not load; its {n} run{} count as failed: {e}",
+                describe_set(b, set),
+                if n == 1 { "" } else { "s" }
+            );
+        }
+    }
+    for j in &b.jobs {
+        match &b.scenarios[j.set] {
+            Some(Ok(_)) => runnable.push(*j),
+            Some(Err(e)) => failed.push(runner::Finished {
+                job: *j,
+                result: Err(e.clone()),
+                wall_s: 0.0,
+            }),
+            None => {}
+        }
+    }
+    bar.inc(failed.len() as u64);
+    bar.set_message(format!("{} failed", failed.len()));
+    let done = runner::run_jobs(
+        &runnable,
+        workers,
+        &bar,
+        failed.len(),
+        |j| {
+            format!(
+                "run {} ({}, seed {})",
+                j.index,
+                describe_set(b, j.set),
+                j.seed
+            )
+        },
+        |j| {
+            let Some(Ok(sc)) = &b.scenarios[j.set] else {
+                anyhow::bail!("set {} has no scenario", j.set);
+            };
+            let mut sc = sc.clone();
+            sc.seed = j.seed;
+            let opts = RunOptions {
+                rrd: rrd_dir.map(|d| d.join(format!("set{}-seed{}.rrd", j.set, j.seed))),
+                threads,
+                progress: false,
+                ..Default::default()
+            };
+            Ok(run_scenario(&sc, &opts)?.summary)
+        },
+    )?;
+    bar.finish_and_clear();
+    let mut all = failed;
+    all.extend(done);
+    all.sort_by_key(|f| f.job.index);
+    Ok(all)
+}
+
+/// The rows of finished runs.
+pub fn rows(b: &Batch, done: &[runner::Finished<Summary>]) -> Vec<Row> {
+    done.iter()
+        .map(|f| {
+            let err = f.result.as_ref().err().map(String::as_str);
+            let mut row = output::run_columns(&f.job, &b.keys, &b.sets[f.job.set], err, f.wall_s);
+            if let Ok(s) = &f.result {
+                row.extend(output::metrics(s));
+            }
+            row
+        })
+        .collect()
+}
+
+/// `sim batch`.
+pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
+    let started = Instant::now();
+    let b = prepare(a)?;
+    let out_dir = a.out.clone().unwrap_or_else(|| default_out(a, &b.name));
+    std::fs::create_dir_all(&out_dir).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot create the output folder: {e}",
+            out_dir.display()
+        )
+    })?;
+    if !a.quiet {
+        let shard = a
+            .shard
+            .as_deref()
+            .map_or(String::new(), |s| format!(", shard {s}"));
+        eprintln!(
+            "batch {}: {} parameter set{} × seeds {}{shard}: {} runs, {} at a time",
+            b.name,
+            b.sets.len(),
+            if b.sets.len() == 1 { "" } else { "s" },
+            a.seeds,
+            b.jobs.len(),
+            if a.jobs == 0 {
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            } else {
+                a.jobs
+            }
+        );
+    }
+    let rrd_dir = a.rrd.then_some(out_dir.as_path());
+    let done = run_batch(&b, a.jobs, a.threads, rrd_dir, !a.quiet)?;
+    let rows = rows(&b, &done);
+    let mut cols = output::columns(&rows);
+    if rows.is_empty() {
+        eprintln!("warning: this shard has no jobs (the batch has fewer than its number)");
+        let none = runner::Job {
+            index: 0,
+            set: 0,
+            seed: 0,
+        };
+        cols = output::columns(&[output::run_columns(&none, &b.keys, &[], None, 0.0)]);
+    }
+    output::write_csv(&out_dir.join("runs.csv"), &cols, &rows)?;
+    output::write_jsonl(&out_dir.join("runs.jsonl"), &rows)?;
+    let stats = aggregate::aggregate(b.sets.len(), &cols, &rows);
+    aggregate::write_aggregate(&out_dir.join("aggregate.csv"), &stats)?;
+    let table = aggregate::table(&stats);
+    let failed = done.iter().filter(|f| f.result.is_err()).count();
+    let wall_s = started.elapsed().as_secs_f64();
+    if !a.quiet {
+        print!("{table}");
+        println!(
+            "{} runs, {failed} failed, in {wall_s:.1} s; runs.csv, runs.jsonl and aggregate.csv \
+             written to {}",
+            done.len(),
+            out_dir.display()
+        );
+    }
+    Ok(BatchReport {
+        out_dir,
+        runs: done.len(),
+        failed,
+        rows,
+        table,
+        wall_s,
+    })
+}

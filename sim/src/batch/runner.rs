@@ -1,0 +1,194 @@
+//! The jobs of a batch (parameter sets major, seeds minor, optionally one shard of them) and
+//! their parallel execution: a rayon pool of `--jobs` workers, each taking the next job until
+//! none is left. A job that errors or panics is recorded as failed; the others go on.
+//!
+//! Each worker runs its job from start to end on its own thread: it is a `broadcast` on the pool
+//! pulling jobs from a shared counter, not one rayon task per job, because a run's kernels run
+//! on the run's own pool (`--threads`) and a rayon worker waiting for another pool steals tasks
+//! of its own pool meanwhile, which would stack a second run on top of the waiting one.
+
+use indicatif::{ProgressBar, ProgressStyle};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// One run: a parameter set with a seed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Job {
+    /// Position in the full batch (sets major, seeds minor), the same in every shard.
+    pub index: usize,
+    pub set: usize,
+    pub seed: u64,
+}
+
+/// The jobs of `sets` parameter sets × `seeds`, or of shard `k/n` of them: jobs k, k+n, …
+pub fn plan_jobs(
+    sets: usize,
+    seeds: std::ops::Range<u64>,
+    shard: Option<(usize, usize)>,
+) -> Vec<Job> {
+    let per_set = (seeds.end - seeds.start) as usize;
+    let (k, n) = shard.unwrap_or((0, 1));
+    (0..sets * per_set)
+        .filter(|i| i % n == k)
+        .map(|index| Job {
+            index,
+            set: index / per_set,
+            seed: seeds.start + (index % per_set) as u64,
+        })
+        .collect()
+}
+
+/// What became of a job, with its wall time (s).
+#[derive(Debug)]
+pub struct Finished<T> {
+    pub job: Job,
+    pub result: Result<T, String>,
+    pub wall_s: f64,
+}
+
+/// A progress bar with ETA and the count of failed runs (hidden when `show` is false).
+pub fn progress_bar(total: usize, show: bool) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(total as u64);
+    b.set_style(
+        ProgressStyle::with_template(
+            "{bar:40.cyan/blue} {pos}/{len} runs  {msg}  [{elapsed_precise} < {eta}]",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message("0 failed");
+    b
+}
+
+fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
+    let msg = p
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(no message)".to_string());
+    format!("panicked: {msg}")
+}
+
+/// Runs `work` on every job with `workers` threads (0 = one per core), catching errors and
+/// panics; results come back in job order. `failed_before` runs already counted as failed
+/// (shown on the bar).
+pub fn run_jobs<T: Send>(
+    jobs: &[Job],
+    workers: usize,
+    bar: &ProgressBar,
+    failed_before: usize,
+    describe: impl Fn(&Job) -> String + Sync,
+    work: impl Fn(&Job) -> anyhow::Result<T> + Sync,
+) -> anyhow::Result<Vec<Finished<T>>> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(workers)
+        .thread_name(|i| format!("sim-batch-{i}"))
+        .build()
+        .map_err(|e| anyhow::anyhow!("--jobs {workers}: cannot start the workers: {e}"))?;
+    let next = AtomicUsize::new(0);
+    let failed = AtomicUsize::new(failed_before);
+    let done: Mutex<Vec<Finished<T>>> = Mutex::new(Vec::with_capacity(jobs.len()));
+    pool.broadcast(|_| {
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(job) = jobs.get(i) else { break };
+            let started = Instant::now();
+            let result = match catch_unwind(AssertUnwindSafe(|| work(job))) {
+                Ok(Ok(v)) => Ok(v),
+                Ok(Err(e)) => Err(format!("{e:#}")),
+                Err(p) => Err(panic_text(p.as_ref())),
+            };
+            if let Err(e) = &result {
+                let n = failed.fetch_add(1, Ordering::Relaxed) + 1;
+                bar.set_message(format!("{n} failed"));
+                bar.suspend(|| eprintln!("{} failed: {e}", describe(job)));
+            }
+            bar.inc(1);
+            let f = Finished {
+                job: *job,
+                result,
+                wall_s: started.elapsed().as_secs_f64(),
+            };
+            // a worker that panicked outside `work` cannot have poisoned this lock while holding it
+            if let Ok(mut d) = done.lock() {
+                d.push(f);
+            }
+        }
+    });
+    let mut done = done
+        .into_inner()
+        .map_err(|_| anyhow::anyhow!("a batch worker failed"))?;
+    done.sort_by_key(|f| f.job.index);
+    Ok(done)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jobs_and_shards() {
+        let all = plan_jobs(2, 5..8, None);
+        assert_eq!(all.len(), 6);
+        assert_eq!(
+            all[0],
+            Job {
+                index: 0,
+                set: 0,
+                seed: 5
+            }
+        );
+        assert_eq!(
+            all[4],
+            Job {
+                index: 4,
+                set: 1,
+                seed: 6
+            }
+        );
+        let a = plan_jobs(2, 5..8, Some((0, 4)));
+        let b = plan_jobs(2, 5..8, Some((1, 4)));
+        let idx: Vec<usize> = a.iter().chain(&b).map(|j| j.index).collect();
+        assert_eq!(idx, [0, 4, 1, 5]);
+        let mut union: Vec<Job> = (0..4)
+            .flat_map(|k| plan_jobs(2, 5..8, Some((k, 4))))
+            .collect();
+        union.sort_by_key(|j| j.index);
+        assert_eq!(union, all);
+    }
+
+    #[test]
+    fn errors_and_panics_do_not_stop_the_others() {
+        let jobs = plan_jobs(1, 0..6, None);
+        let bar = ProgressBar::hidden();
+        let out = run_jobs(
+            &jobs,
+            2,
+            &bar,
+            0,
+            |j| format!("seed {}", j.seed),
+            |j| match j.seed {
+                2 => anyhow::bail!("bad seed"),
+                4 => panic!("seed four"),
+                s => Ok(s * 10),
+            },
+        )
+        .unwrap();
+        let got: Vec<Result<u64, String>> = out.into_iter().map(|f| f.result).collect();
+        assert_eq!(
+            got,
+            [
+                Ok(0),
+                Ok(10),
+                Err("bad seed".to_string()),
+                Ok(30),
+                Err("panicked: seed four".to_string()),
+                Ok(50)
+            ]
+        );
+    }
+}

@@ -1,0 +1,228 @@
+//! Parameter sets: the `--set` overrides shared by every run, and one combination of `--sweep`
+//! values (Cartesian product, the first sweep varying slowest) and `--zip` values (advancing
+//! together, the last axis) per set. Each set's scenario is the file with its overrides applied,
+//! loaded and validated as a scenario file is.
+
+use super::args::{split_key_value, split_values};
+use super::params::{Override, blame};
+use crate::scenario::{Scenario, parse_scenario};
+use std::path::{Path, PathBuf};
+use toml_edit::DocumentMut;
+
+/// The overrides of every parameter set, in set order, and the keys that vary or are set.
+#[derive(Clone, Debug)]
+pub struct SetPlan {
+    /// Every `--set`, `--sweep` and `--zip` key in command-line order of the flags' kinds.
+    pub keys: Vec<String>,
+    /// Per set: its overrides (the `--set` ones first).
+    pub sets: Vec<Vec<Override>>,
+}
+
+fn overrides_of(flag: &'static str, arg: &str) -> anyhow::Result<Vec<Override>> {
+    let (k, v) = split_key_value(flag, arg)?;
+    split_values(flag, v)?
+        .iter()
+        .map(|v| Override::new(flag, k, v))
+        .collect()
+}
+
+/// Builds the parameter sets of `--set`, `--sweep` and `--zip` arguments.
+pub fn plan_sets(sets: &[String], sweeps: &[String], zips: &[String]) -> anyhow::Result<SetPlan> {
+    let mut fixed = Vec::new();
+    for s in sets {
+        let (k, v) = split_key_value("--set", s)?;
+        fixed.push(Override::new("--set", k, v)?);
+    }
+    // axes: each a list of points, each point a list of overrides
+    let mut axes: Vec<Vec<Vec<Override>>> = Vec::new();
+    for s in sweeps {
+        axes.push(
+            overrides_of("--sweep", s)?
+                .into_iter()
+                .map(|o| vec![o])
+                .collect(),
+        );
+    }
+    if !zips.is_empty() {
+        let lists = zips
+            .iter()
+            .map(|z| overrides_of("--zip", z))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let n = lists[0].len();
+        if let Some((z, l)) = zips.iter().zip(&lists).find(|(_, l)| l.len() != n) {
+            anyhow::bail!(
+                "--zip {z}: {} values, but --zip {} has {n}: every --zip needs the same number",
+                l.len(),
+                zips[0]
+            );
+        }
+        axes.push(
+            (0..n)
+                .map(|i| lists.iter().map(|l| l[i].clone()).collect())
+                .collect(),
+        );
+    }
+    let mut keys: Vec<String> = fixed.iter().map(|o| o.key.clone()).collect();
+    let mut flags: Vec<&str> = fixed.iter().map(|o| o.flag).collect();
+    for axis in &axes {
+        for o in &axis[0] {
+            keys.push(o.key.clone());
+            flags.push(o.flag);
+        }
+    }
+    for (i, k) in keys.iter().enumerate() {
+        if let Some(j) = keys[..i].iter().position(|p| p == k) {
+            anyhow::bail!(
+                "{k}: given twice ({} and {}); each key may be set or varied once",
+                flags[j],
+                flags[i]
+            );
+        }
+    }
+    // odometer over the axes, the first axis varying slowest
+    let mut out = Vec::new();
+    let mut at = vec![0usize; axes.len()];
+    loop {
+        let mut set = fixed.clone();
+        for (axis, &i) in axes.iter().zip(&at) {
+            set.extend(axis[i].iter().cloned());
+        }
+        out.push(set);
+        let mut d = axes.len();
+        loop {
+            if d == 0 {
+                return Ok(SetPlan { keys, sets: out });
+            }
+            d -= 1;
+            at[d] += 1;
+            if at[d] < axes[d].len() {
+                break;
+            }
+            at[d] = 0;
+        }
+    }
+}
+
+/// The scenario file every set starts from.
+pub struct Source {
+    pub path: PathBuf,
+    pub label: String,
+    base_dir: PathBuf,
+    stem: String,
+    doc: DocumentMut,
+    /// The file as it is (for sets without overrides).
+    pub plain: Scenario,
+}
+
+impl Source {
+    /// Loads and validates the file as `sim run` does, and keeps its TOML document.
+    pub fn load(path: &Path) -> anyhow::Result<Source> {
+        let label = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("{label}: cannot read: {e}"))?;
+        let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let stem = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("scenario");
+        let mut source = Source::from_text(&text, &label, &base_dir, stem)?;
+        source.path = path.to_path_buf();
+        Ok(source)
+    }
+
+    /// Scenario text from elsewhere (the attachment of a recording), called `label` in errors,
+    /// its relative paths resolved against `base_dir`, named `stem` unless it names itself.
+    pub fn from_text(
+        text: &str,
+        label: &str,
+        base_dir: &Path,
+        stem: &str,
+    ) -> anyhow::Result<Source> {
+        let plain = parse_scenario(text, label, base_dir, stem)?;
+        let doc: DocumentMut = text
+            .parse()
+            .map_err(|e| anyhow::anyhow!("{label}: not TOML: {e}"))?;
+        Ok(Source {
+            base_dir: base_dir.to_path_buf(),
+            stem: stem.to_string(),
+            path: PathBuf::from(label),
+            label: label.to_string(),
+            doc,
+            plain,
+        })
+    }
+
+    /// The scenario of one parameter set, or the error naming the override(s) at fault.
+    pub fn scenario(&self, overrides: &[Override]) -> Result<Scenario, String> {
+        if overrides.is_empty() {
+            return Ok(self.plain.clone());
+        }
+        let mut doc = self.doc.clone();
+        let mut applied = Vec::new();
+        for o in overrides {
+            let at = o.apply(&mut doc).map_err(|e| e.to_string())?;
+            applied.push((o.clone(), at));
+        }
+        parse_scenario(&doc.to_string(), &self.label, &self.base_dir, &self.stem).map_err(|e| {
+            let culprits = e.key.as_deref().map_or(Vec::new(), |k| blame(&applied, k));
+            let named: Vec<String> = if culprits.is_empty() {
+                overrides.iter().map(Override::describe).collect()
+            } else {
+                culprits.iter().map(|o| o.describe()).collect()
+            };
+            format!("{}: {e}", named.join(", "))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn strs(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    fn show(p: &SetPlan) -> Vec<String> {
+        p.sets
+            .iter()
+            .map(|s| {
+                s.iter()
+                    .map(|o| format!("{}={}", o.key, o.text))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .collect()
+    }
+
+    #[test]
+    fn product_and_zip() {
+        let p = plan_sets(
+            &strs(&["duration=5"]),
+            &strs(&["a=1,2", "b=x,y"]),
+            &strs(&["c=10,20", "d=[1,2],[3,4]"]),
+        )
+        .unwrap();
+        assert_eq!(p.keys, ["duration", "a", "b", "c", "d"]);
+        let s = show(&p);
+        assert_eq!(s.len(), 8);
+        assert_eq!(s[0], "duration=5 a=1 b=x c=10 d=[1,2]");
+        assert_eq!(s[1], "duration=5 a=1 b=x c=20 d=[3,4]");
+        assert_eq!(s[2], "duration=5 a=1 b=y c=10 d=[1,2]");
+        assert_eq!(s[7], "duration=5 a=2 b=y c=20 d=[3,4]");
+        assert_eq!(show(&plan_sets(&[], &[], &[]).unwrap()), [""]);
+    }
+
+    #[test]
+    fn plan_errors() {
+        let e = |s: &[&str], w: &[&str], z: &[&str]| {
+            plan_sets(&strs(s), &strs(w), &strs(z))
+                .unwrap_err()
+                .to_string()
+        };
+        assert!(e(&["a=1"], &["a=1,2"], &[]).contains("a: given twice (--set and --sweep)"));
+        assert!(e(&[], &[], &["a=1,2", "b=1"]).contains("every --zip needs the same number"));
+        assert!(e(&["duration"], &[], &[]).contains("--set duration: expected KEY=VALUE"));
+        assert!(e(&[], &["seed=1,2"], &[]).contains("the seed of each run comes from --seeds"));
+    }
+}

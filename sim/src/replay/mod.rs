@@ -1,0 +1,165 @@
+//! `sim replay FILE.mcap`: re-runs localization, SLAM and evaluation on recorded sensor data,
+//! without physics, sensors, control or navigation (DESIGN.md, "Formats to speak": replays).
+//!
+//! The world is built from the scenario as for a live run, with only the estimators' and the
+//! evaluation's systems ([`crate::build::BuildMode::Replay`]); a feed system in the Sense set
+//! ([`feed`]) hands each robot, tick by tick, the scans, encoder readings or odometry poses and
+//! true poses read from the file ([`source`]). Scenario events still fire (a door that closes
+//! changes the map the localizers believe in).
+//!
+//! Our own files (`sim run --mcap`) carry the scenario and the run's seed, tick and topic
+//! periods (attachments `scenario.toml` and `run.json`), and exact stamps: with the same seed
+//! the localizers and SLAM systems get bit for bit the readings of the live run in the same
+//! ticks, draw the same random numbers, and so reproduce its estimates exactly. Error figures
+//! agree to about 1e-7 m, not bit for bit: the truth's heading comes back from a quaternion, and
+//! a live run's first tick starts from the physics engine's f32 copy of the start pose.
+//!
+//! Files of other ROS 2 systems: `--scenario` gives the map, the robot (`--robot` if it has
+//! several) with its laser mount and localizers; sensor_msgs/LaserScan from `--scan-topic`
+//! (`/scan`) and nav_msgs/Odometry poses from `--odom-topic` (`/odom`) are fed in, times are
+//! header stamps counted from the first one. Ground truth (PoseStamped or Odometry in the map
+//! frame) only with `--truth-topic`; without it the error figures are against the start pose
+//! and mean nothing. Road localization (GPS, compass, camera) is not replayed: it needs every
+//! camera frame and the road navigator's decisions.
+
+mod feed;
+mod plan;
+mod source;
+
+pub use feed::{ReplayFeed, feed_recorded};
+pub use plan::{ReplayPlan, plan};
+pub use source::{RobotFeed, TopicFlags};
+
+use crate::build::{BuildMode, build_world_with};
+use crate::record::mcap::McapRecording;
+use crate::run_cmd::{OutputArgs, report_run};
+use crate::run_exports::RunExports;
+use crate::runner::{RunOptions, RunOutput, run_built};
+use bevy_ecs::prelude::*;
+use feed::FedRobot;
+use std::path::PathBuf;
+use systems::core::SimSet;
+use systems::sensors::EncoderReadings;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct ReplayArgs {
+    /// An MCAP file: written by `sim run --mcap`, or by another ROS 2 system (then give
+    /// --scenario).
+    pub file: PathBuf,
+    /// The scenario to replay in (a file or a bundled name); default: the one attached to the
+    /// recording.
+    #[arg(long)]
+    pub scenario: Option<String>,
+    /// Override the seed of the localizers' random numbers (default: the recorded run's).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Override a scenario key, as `sim batch --set` does (`robots.0.localizers.0.particles=500`).
+    /// Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+    /// Replay only this robot of the scenario (needed with topic flags when it has several).
+    #[arg(long)]
+    pub robot: Option<String>,
+    /// sensor_msgs/LaserScan topic (default: /<robot>/scan in our files, /scan otherwise).
+    #[arg(long)]
+    pub scan_topic: Option<String>,
+    /// nav_msgs/Odometry topic whose poses replace wheel odometry (default for foreign files:
+    /// /odom; our files replay the encoder ticks of /<robot>/joint_states).
+    #[arg(long)]
+    pub odom_topic: Option<String>,
+    /// sensor_msgs/JointState topic of the wheel encoders (default: /<robot>/joint_states).
+    #[arg(long)]
+    pub joint_states_topic: Option<String>,
+    /// Ground truth, geometry_msgs/PoseStamped or nav_msgs/Odometry in the map frame (default:
+    /// /<robot>/ground_truth in our files, none otherwise).
+    #[arg(long)]
+    pub truth_topic: Option<String>,
+    #[command(flatten)]
+    pub out: OutputArgs,
+}
+
+/// Replays `plan` (see the module doc).
+pub fn replay(
+    plan: ReplayPlan,
+    opts: &RunOptions,
+    exports: &RunExports,
+) -> anyhow::Result<RunOutput> {
+    let ReplayPlan {
+        scenario, feeds, ..
+    } = plan;
+    let mut sim = build_world_with(&scenario, opts.threads, BuildMode::Replay)?;
+    let mut robots = Vec::with_capacity(feeds.len());
+    for (&entity, feed) in sim.robots.iter().zip(feeds) {
+        if !feed.odometry.is_empty() {
+            // odometry poses replace the encoder: wheel odometry must not integrate ticks
+            sim.world.entity_mut(entity).remove::<EncoderReadings>();
+            if sim
+                .world
+                .get::<systems::localization::WheelOdometry>(entity)
+                .is_none()
+            {
+                let start = sim.world.get::<systems::body::TruePose>(entity);
+                let start = start.map(|t| t.pose).unwrap_or_default();
+                sim.world
+                    .entity_mut(entity)
+                    .insert(systems::localization::WheelOdometry::new(
+                        systems::localization::OdometryModel::DiffDrive {
+                            left_radius: 1.0,
+                            right_radius: 1.0,
+                            wheel_base: 1.0,
+                        },
+                        1,
+                        start,
+                    ));
+            }
+        }
+        robots.push(FedRobot::new(entity, feed));
+    }
+    sim.world.insert_resource(ReplayFeed { robots });
+    sim.schedule
+        .add_systems(feed_recorded.in_set(SimSet::Sense));
+    run_built(sim, &scenario, opts, exports)
+}
+
+/// `sim replay`.
+pub fn replay_command(a: &ReplayArgs) -> anyhow::Result<()> {
+    let rec = McapRecording::open(&a.file)?;
+    let plan = plan(a, &rec)?;
+    drop(rec);
+    let sc = &plan.scenario;
+    if !a.out.quiet {
+        let topics: Vec<&str> = plan
+            .feeds
+            .iter()
+            .flat_map(|f| f.topics.iter().map(String::as_str))
+            .collect();
+        eprintln!(
+            "replaying {} ({} robots, {:.1} s recorded, seed {}) from {}: {}",
+            sc.name,
+            sc.robots.len(),
+            sc.duration,
+            sc.seed,
+            a.file.display(),
+            topics.join(", ")
+        );
+        if plan.feeds.iter().any(|f| f.truth.is_empty()) {
+            eprintln!(
+                "note: no ground truth topic (--truth-topic): error figures are against the start \
+                 pose and mean nothing"
+            );
+        }
+    }
+    let rrd = a.out.rrd_path(|| {
+        let stem = a.file.file_stem().and_then(|s| s.to_str()).unwrap_or("run");
+        PathBuf::from(format!("{stem}-replay.rrd"))
+    });
+    let exports = RunExports {
+        save_map: a.out.save_map.clone(),
+        ..Default::default()
+    };
+    let out = replay(plan, &a.out.run_options(rrd.clone()), &exports)?;
+    report_run(&out, &a.out.report(rrd.as_deref(), None))
+}
+
+#[cfg(test)]
+mod tests;
