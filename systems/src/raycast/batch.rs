@@ -79,6 +79,11 @@ impl RayMap {
                 *next += 1;
                 let (p, dx, dy) = ray(i);
                 let (gx, gy) = (p[0] - origin[0], p[1] - origin[1]);
+                if !(gx.is_finite() && gy.is_finite() && dx.is_finite() && dy.is_finite()) {
+                    // no defined ray (a NaN or infinite pose): nothing to walk along
+                    out[i] = f32::NAN;
+                    continue;
+                }
                 let mut t = 0.0;
                 if !(gx >= 0.0 && gy >= 0.0 && gx < wf && gy < hf) {
                     match enter_grid(gx, gy, dx, dy, wf, hf, max_range) {
@@ -148,11 +153,14 @@ impl RayMap {
                     } else {
                         f32::INFINITY
                     };
+                    // never back along the ray: a ray running along a cell boundary can find
+                    // the boundary it crosses a rounding error behind it, and leaping on from
+                    // there could cycle between two cells for ever
                     if tx < ty {
-                        l.t = tx;
+                        l.t = tx.max(l.t);
                         l.cx += l.sx;
                     } else {
-                        l.t = ty;
+                        l.t = ty.max(l.t);
                         l.cy += l.sy;
                     }
                     if l.t > max_range || l.cx < 0 || l.cy < 0 || l.cx >= w || l.cy >= h {

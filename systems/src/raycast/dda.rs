@@ -49,12 +49,13 @@ impl Walk {
     /// Moves into the next cell.
     #[inline(always)]
     pub fn step(&mut self) {
+        // `max`: never back along the ray (a boundary a rounding error behind a restarted walk)
         if self.t_max_x < self.t_max_y {
-            self.t = self.t_max_x;
+            self.t = self.t_max_x.max(self.t);
             self.cx += self.sx;
             self.t_max_x += self.t_delta_x;
         } else {
-            self.t = self.t_max_y;
+            self.t = self.t_max_y.max(self.t);
             self.cy += self.sy;
             self.t_max_y += self.t_delta_y;
         }

@@ -460,3 +460,23 @@ fn segment_traversal_visits_exactly_the_crossed_cells() {
     }
     assert!(full > 300 && clipped > 300, "{full} {clipped}");
 }
+
+/// A ray running along a cell boundary next to a wall (hospital_patrol seed 15, a DE filter
+/// member): the boundary it crosses lies a rounding error behind it, and the walk used to cycle
+/// between two cells for ever. Both walks now end, and agree.
+#[test]
+fn a_ray_along_a_cell_boundary_beside_a_wall_ends() {
+    let (w, h) = (1280, 640);
+    let mut occupied = vec![false; w * h];
+    for c in 0..w {
+        occupied[518 * w + c] = true;
+    }
+    let rm = RayMap::new(w, h, 0.05, [0.0, 0.0], &occupied);
+    let (p, dx, dy) = ([12.828864f32, 25.85018f32], 1.0f32, -3.8027763e-5f32);
+    let angle = dy.atan2(dx);
+    let mut out = [0.0f32];
+    rm.cast_many(&[(p, angle)], 20.0, &mut out);
+    let one = rm.cast(p, angle, 20.0);
+    assert_eq!(out[0].to_bits(), one.to_bits());
+    assert_eq!(one, f32::INFINITY, "the ray runs below the wall to its end");
+}
