@@ -38,7 +38,9 @@ use crate::runner::{RunOptions, RunOutput, run_built};
 use bevy_ecs::prelude::*;
 use feed::FedRobot;
 use std::path::PathBuf;
+use systems::body::TruePose;
 use systems::core::SimSet;
+use systems::localization::{OdometryModel, WheelOdometry};
 use systems::sensors::EncoderReadings;
 
 #[derive(clap::Args, Clone, Debug)]
@@ -93,24 +95,16 @@ pub fn replay(
         if !feed.odometry.is_empty() {
             // odometry poses replace the encoder: wheel odometry must not integrate ticks
             sim.world.entity_mut(entity).remove::<EncoderReadings>();
-            if sim
-                .world
-                .get::<systems::localization::WheelOdometry>(entity)
-                .is_none()
-            {
-                let start = sim.world.get::<systems::body::TruePose>(entity);
-                let start = start.map(|t| t.pose).unwrap_or_default();
-                sim.world
-                    .entity_mut(entity)
-                    .insert(systems::localization::WheelOdometry::new(
-                        systems::localization::OdometryModel::DiffDrive {
-                            left_radius: 1.0,
-                            right_radius: 1.0,
-                            wheel_base: 1.0,
-                        },
-                        1,
-                        start,
-                    ));
+            if sim.world.get::<WheelOdometry>(entity).is_none() {
+                // no encoder in the scenario: the odometry only holds the recorded poses
+                let start = sim.world.get::<TruePose>(entity).map(|t| t.pose);
+                let model = OdometryModel::DiffDrive {
+                    left_radius: 1.0,
+                    right_radius: 1.0,
+                    wheel_base: 1.0,
+                };
+                let odom = WheelOdometry::new(model, 1, start.unwrap_or_default());
+                sim.world.entity_mut(entity).insert(odom);
             }
         }
         robots.push(FedRobot::new(entity, feed));

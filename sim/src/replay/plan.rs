@@ -17,7 +17,7 @@ pub struct ReplayPlan {
     pub scenario: Scenario,
     /// `run.json` of our own files.
     pub run: Option<RunInfo>,
-    /// (index of the robot in the scenario, its readings); the scenario keeps only these.
+    /// Each replayed robot's readings, in the order of `scenario.robots` (which keeps only them).
     pub feeds: Vec<RobotFeed>,
 }
 
