@@ -5,6 +5,10 @@
 //! the ticks run.
 
 use crate::build::{SimWorld, build_world};
+use crate::mcap_out::{McapExport, record_mcap};
+use crate::record::frames::{
+    FrameOutputs, RecordedFrames, collect_frames, log_frames_rrd, record_frames_rrd,
+};
 use crate::record::outdoor::{OutdoorRecording, record_outdoor};
 use crate::record::slam::{SlamRecording, record_slam, record_slam_final};
 use crate::record::{RrdRecorder, record_navigation, record_rrd};
@@ -17,7 +21,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::time::Instant;
 use systems::body::TruePose;
-use systems::core::{Pose2, RobotId, RobotIndex, SimSet};
+use systems::core::{Pose2, RobotId, RobotIndex, SimClock, SimSet};
 use systems::eval::road_metrics::RoadRunMetrics;
 use systems::eval::{
     LocalizationSamples, LocalizerMetrics, NavOutcome, RobotMetrics, Sample, TrajectoryMetrics,
@@ -27,7 +31,7 @@ use systems::localization::road_wiring::RoadLocalization;
 use systems::localization::{Filter, Localizers};
 use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
 use systems::navigation::{Behaviour, NavStatus, Navigator};
-use systems::sensors::{LaserScans, LaserTruth};
+use systems::sensors::{Camera, LaserScans, LaserTruth};
 use systems::world::roads::RoadMap;
 
 #[derive(Clone, Debug, Default)]
@@ -274,7 +278,6 @@ fn run_world(
             scenario.record.slam_rate,
         ));
         sim.world.insert_resource(OutdoorRecording::new(
-            scenario.record.camera_rate,
             scenario.record.rate,
             scenario.record.particle_rate,
         ));
@@ -285,6 +288,7 @@ fn run_world(
         );
     }
     exports.install(&mut sim, scenario)?;
+    install_frames(&mut sim, scenario, opts, exports)?;
     let ticks = (scenario.duration / scenario.dt).round().max(1.0) as u64;
     let bar = if opts.progress {
         let b = ProgressBar::new(ticks);
@@ -338,6 +342,7 @@ fn run_world(
     }
     bar.finish_and_clear();
     finish_slam(&mut sim.world);
+    let frame_error = finish_frames(&mut sim.world);
     let wall_time_s = started.elapsed().as_secs_f64();
     if sim.world.contains_resource::<RrdRecorder>() {
         record_slam_final(&mut sim.world);
@@ -348,6 +353,9 @@ fn run_world(
     let exported = exports.finish(&mut sim.world, scenario)?;
     if opts.trajectory_period.is_some() {
         trajectory.push((sim.time(), truth_poses(&mut sim.world)));
+    }
+    if let Some(e) = frame_error {
+        anyhow::bail!("recording camera frames: {e}");
     }
     let sim_time_s = ticks_run as f64 * scenario.dt;
     let summary = Summary {
@@ -367,6 +375,48 @@ fn run_world(
         exported,
         interrupted,
     })
+}
+
+/// Renders whole camera frames for the recordings on a worker thread when a recording is
+/// written and a robot carries a camera ([`crate::record::frames`]).
+fn install_frames(
+    sim: &mut SimWorld,
+    scenario: &Scenario,
+    opts: &RunOptions,
+    exports: &RunExports,
+) -> anyhow::Result<()> {
+    let outputs = FrameOutputs {
+        raw: exports.mcap.is_some(),
+        jpeg: opts.rrd.is_some(),
+    };
+    let cameras = sim.world.query::<&Camera>().iter(&sim.world).count();
+    if cameras == 0 || !(outputs.raw || outputs.jpeg) {
+        return Ok(());
+    }
+    let frames = RecordedFrames::new(scenario.record.camera_rate, outputs)?;
+    sim.world.insert_resource(frames);
+    let collect = collect_frames.in_set(SimSet::Record).before(record_mcap);
+    if outputs.jpeg {
+        sim.schedule
+            .add_systems((collect, record_frames_rrd.in_set(SimSet::Record)).chain());
+    } else {
+        sim.schedule.add_systems(collect);
+    }
+    Ok(())
+}
+
+/// The run is over: the camera frames still being rendered go to the recordings; the worker's
+/// error, if any.
+fn finish_frames(w: &mut World) -> Option<String> {
+    let (mut frames, error) = w.remove_resource::<RecordedFrames>()?.finish();
+    let now = w.resource::<SimClock>().now();
+    if let Some(mut r) = w.get_resource_mut::<RrdRecorder>() {
+        log_frames_rrd(&mut r, &frames, now);
+    }
+    if let Some(mut export) = w.get_resource_mut::<McapExport>() {
+        export.write_frames(&mut frames);
+    }
+    error
 }
 
 /// The run is over: SLAM systems run their final optimization (before the recording's last

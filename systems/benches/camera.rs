@@ -56,11 +56,20 @@ fn bench_camera(c: &mut Criterion) {
     grp.bench_function("render_320x240", |b| {
         b.iter(|| cam.capture(0.0, black_box(pose), &raster, &mut img))
     });
+    // a recorder's frame: the whole image on one thread
+    let frame = cam.take(0.0, pose);
+    let mut rgb = vec![0u8; img.rgb.len()];
+    grp.bench_function("render_320x240_one_thread", |b| {
+        b.iter(|| {
+            cam.view(black_box(&frame), &raster)
+                .pixels
+                .render_here(&mut rgb)
+        })
+    });
     grp.bench_function("recognize_320x240", |b| {
         b.iter(|| black_box(rec.recognize(black_box(&img))))
     });
     // what a run does per frame: the recognizer computes only the pixels it reads
-    let frame = cam.take(0.0, pose);
     grp.bench_function("take_and_recognize_320x240", |b| {
         b.iter(|| black_box(rec.recognize(&cam.view(black_box(&frame), &raster))))
     });

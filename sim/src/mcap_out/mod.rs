@@ -45,7 +45,6 @@ use bevy_ecs::prelude::*;
 use robot::RobotTopics;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 /// A topic as `run.json` lists it.
 #[derive(Serialize, Deserialize, Clone, Debug)]
@@ -92,12 +91,9 @@ const STAMP_RULE: &str = "log time = publish time = header stamp = simulation ti
 /// The replay being written (a resource while the run lasts).
 #[derive(Resource)]
 pub struct McapExport {
-    /// In a mutex only because a resource must be `Sync` and the lz4 encoder is not; the
-    /// system reaches it through `&mut` without locking.
-    rec: Mutex<McapRecorder>,
+    rec: McapRecorder,
     robots: Vec<RobotTopics>,
     tf: Channel<TFMessage>,
-    camera_period: f64,
     /// The first write error; nothing more is written after it.
     error: Option<anyhow::Error>,
     /// Reused between ticks.
@@ -150,10 +146,9 @@ impl McapExport {
             )?;
         }
         Ok(McapExport {
-            rec: Mutex::new(rec),
+            rec,
             robots,
             tf,
-            camera_period: 1.0 / scenario.record.camera_rate,
             error: None,
             transforms: Vec::new(),
         })
@@ -161,7 +156,7 @@ impl McapExport {
 
     /// Writes the summary and footer: the file is complete.
     pub fn finish(self) -> anyhow::Result<McapWritten> {
-        let rec = self.rec.into_inner().unwrap_or_else(|e| e.into_inner());
+        let rec = self.rec;
         let path = rec.path().to_path_buf();
         if let Some(e) = self.error {
             return Err(e);

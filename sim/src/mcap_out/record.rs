@@ -4,19 +4,16 @@
 use super::McapExport;
 use super::convert::*;
 use super::robot::RobotTopics;
+use crate::record::frames::{RecordedFrame, RecordedFrames};
 use crate::record::mcap::McapRecorder;
 use crate::record::mcap::messages::{Image, Range};
 use crate::record::mcap::stamp_ns;
 use bevy_ecs::prelude::*;
 use systems::body::TruePose;
-use systems::core::{KernelPool, RobotIndex, SimClock};
+use systems::core::{RobotIndex, SimClock};
 use systems::localization::nav_source::NavSource;
 use systems::localization::{Localizers, WheelOdometry};
-use systems::sensors::camera::surface_or_grass;
-use systems::sensors::{
-    Camera, CameraImages, CompassReadings, EncoderReadings, GpsReadings, LaserScans, SonarReadings,
-};
-use systems::world::roads::{RoadSurface, SurfaceRaster};
+use systems::sensors::{CompassReadings, EncoderReadings, GpsReadings, LaserScans, SonarReadings};
 
 /// What a robot offers this tick.
 type RobotData<'a> = (
@@ -27,30 +24,27 @@ type RobotData<'a> = (
     Option<&'a WheelOdometry>,
     Option<&'a GpsReadings>,
     Option<&'a CompassReadings>,
-    Option<(&'a Camera, &'a CameraImages)>,
     Option<&'a SonarReadings>,
     Option<&'a Localizers>,
     Option<&'a NavSource>,
 );
 
-/// Record set: writes this tick's messages (see the module doc of [`crate::mcap_out`]).
+/// Record set, after [`crate::record::frames::collect_frames`]: writes this tick's messages
+/// and the camera frames collected in it (see the module doc of [`crate::mcap_out`]).
 pub fn record_mcap(
     export: ResMut<McapExport>,
     clock: Res<SimClock>,
-    (surface, pool): (Option<Res<RoadSurface>>, Option<Res<KernelPool>>),
+    frames: Option<ResMut<RecordedFrames>>,
     robots: Query<RobotData<'_>>,
 ) {
     let export = export.into_inner();
-    let empty = SurfaceRaster::empty();
-    let camera_view = CameraView {
-        raster: surface_or_grass(surface.as_deref(), &empty),
-        pool: pool.as_deref(),
-        period: export.camera_period,
-    };
+    if let Some(mut frames) = frames {
+        export.write_frames(&mut frames.ready);
+    }
     if export.error.is_some() {
         return;
     }
-    let rec = export.rec.get_mut().unwrap_or_else(|e| e.into_inner());
+    let rec = &mut export.rec;
     let now = clock.now();
     let mut rows: Vec<RobotData<'_>> = robots.iter().collect();
     rows.sort_by_key(|r| r.0.0);
@@ -59,7 +53,7 @@ pub fn record_mcap(
         let Some(t) = export.robots.iter_mut().find(|t| t.index == row.0.0) else {
             return Ok(());
         };
-        write_robot(rec, t, row, now, &camera_view, &mut export.transforms)
+        write_robot(rec, t, row, now, &mut export.transforms)
     });
     let result = result.and_then(|()| {
         if export.transforms.is_empty() {
@@ -77,23 +71,14 @@ pub fn record_mcap(
     }
 }
 
-/// What rendering a camera frame for the file needs.
-struct CameraView<'a> {
-    raster: &'a SurfaceRaster,
-    pool: Option<&'a KernelPool>,
-    /// Seconds between recorded frames.
-    period: f64,
-}
-
 fn write_robot(
     rec: &mut McapRecorder,
     t: &mut RobotTopics,
     row: &RobotData<'_>,
     now: f64,
-    cv: &CameraView<'_>,
     transforms: &mut Vec<crate::record::mcap::messages::TransformStamped>,
 ) -> anyhow::Result<()> {
-    let (_, truth, scans, encoders, odom, gps, compass, camera, sonars, locs, nav) = *row;
+    let (_, truth, scans, encoders, odom, gps, compass, sonars, locs, nav) = *row;
     if let (Some((ch, scan_time)), Some(scans)) = (t.scan, scans) {
         for s in &scans.scans {
             rec.write(
@@ -146,26 +131,6 @@ fn write_robot(
             };
             rec.write(ch, stamp_ns(readings.stamp), &msg)?;
         }
-    }
-    if let (Some(ch), Some((camera, images))) = (t.camera, camera)
-        && images.fresh
-        && let Some(frame) = &images.frame
-        && t.last_image
-            .is_none_or(|last| frame.stamp >= last + cv.period - 1e-9)
-    {
-        t.last_image = Some(frame.stamp);
-        // the whole frame (a run computes only the pixels its recognizer reads)
-        let img = match cv.pool {
-            Some(p) => p.install(|| camera.render(frame, cv.raster)),
-            None => camera.render(frame, cv.raster),
-        };
-        let msg = Image::rgb8(
-            header(img.stamp, &t.camera_frame),
-            img.width,
-            img.height,
-            img.rgb,
-        );
-        rec.write(ch, stamp_ns(img.stamp), &msg)?;
     }
     rec.write(
         t.truth,
@@ -222,5 +187,33 @@ fn update_correction(
         let at = odom.pose_at(latest.stamp);
         t.correction = latest.estimate.pose.compose(&at.inverse());
         t.correction_stamp = latest.stamp;
+    }
+}
+
+impl McapExport {
+    /// Writes camera frames (`sensor_msgs/Image`, rgb8) to their robots' topics (taking their
+    /// raw images).
+    pub fn write_frames(&mut self, frames: &mut [RecordedFrame]) {
+        if self.error.is_some() {
+            return;
+        }
+        let rec = &mut self.rec;
+        for f in frames {
+            let Some(img) = f.raw.take() else { continue };
+            let Some(t) = self.robots.iter().find(|t| t.index == f.robot.0) else {
+                continue;
+            };
+            let Some(ch) = t.camera else { continue };
+            let msg = Image::rgb8(
+                header(img.stamp, &t.camera_frame),
+                img.width,
+                img.height,
+                img.rgb,
+            );
+            if let Err(e) = rec.write(ch, stamp_ns(img.stamp), &msg) {
+                self.error = Some(e);
+                return;
+            }
+        }
     }
 }

@@ -40,8 +40,6 @@ pub(super) struct RobotTopics {
     pub odom_start: Pose2,
     /// The last odometry pose written (stamp, pose).
     pub last_odom: Option<(f64, Pose2)>,
-    /// Stamp of the last camera image written.
-    pub last_image: Option<f64>,
     /// map → odom from the best localizer's latest estimate, and that estimate's stamp.
     pub correction: Pose2,
     pub correction_stamp: f64,
@@ -197,7 +195,6 @@ pub(super) fn robot_topics(
             sonars,
             odom_start: odom_start.unwrap_or(Pose2::IDENTITY),
             last_odom: None,
-            last_image: None,
             correction: Pose2::IDENTITY,
             correction_stamp: f64::NEG_INFINITY,
         });

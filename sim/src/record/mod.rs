@@ -3,12 +3,14 @@
 //! writer and reader; not yet wired to the runner).
 
 pub mod belief;
+pub mod frames;
 pub mod mcap;
 pub mod navigation;
 pub mod outdoor;
 pub mod replay;
 pub mod rrd;
 pub mod slam;
+pub mod stream;
 pub mod tum;
 
 pub use navigation::record_navigation;

@@ -14,19 +14,16 @@
 //! - `robots/<name>/error/<road localizer>`: its position error against the truth;
 //! - `robots/<name>/path`: the planned road route (line strip) whenever it changes, and
 //!   `robots/<name>/task`: the navigator's events (plans, re-plans, junction moves, arrival);
-//! - `robots/<name>/camera`: the camera image with the recognized road drawn in (JPEG), at the
-//!   camera recording rate.
+//!
+//! The camera images (`robots/<name>/camera`) come from [`super::frames`].
 
 use super::rrd::RrdRecorder;
 use bevy_ecs::prelude::*;
 use systems::body::TruePose;
-use systems::core::{KernelPool, RobotId, RobotIndex, SimClock};
+use systems::core::{RobotId, RobotIndex, SimClock};
 use systems::localization::road_wiring::RoadLocalization;
 use systems::navigation::road_drive::RoadNavigator;
-use systems::navigation::road_recognition::{RoadDetector, draw_detection};
-use systems::sensors::camera::surface_or_grass;
-use systems::sensors::{Camera, CameraImages};
-use systems::world::roads::{RoadGraph, RoadMap, RoadSurface, Surface, SurfaceRaster};
+use systems::world::roads::{RoadGraph, RoadMap, Surface};
 use systems::world::{ZoneKind, ZoneShape, Zones};
 
 /// Per robot: what has been logged already.
@@ -37,12 +34,10 @@ struct Logged {
     route_start: Option<usize>,
     particles_at: f64,
     poses_at: f64,
-    camera_at: f64,
 }
 
 #[derive(Resource)]
 pub struct OutdoorRecording {
-    camera_period: f64,
     pose_period: f64,
     particle_period: f64,
     started: bool,
@@ -50,9 +45,8 @@ pub struct OutdoorRecording {
 }
 
 impl OutdoorRecording {
-    pub fn new(camera_rate: f64, pose_rate: f64, particle_rate: f64) -> Self {
+    pub fn new(pose_rate: f64, particle_rate: f64) -> Self {
         OutdoorRecording {
-            camera_period: 1.0 / camera_rate,
             pose_period: 1.0 / pose_rate,
             particle_period: 1.0 / particle_rate,
             started: false,
@@ -151,30 +145,23 @@ fn ramp(t: f32) -> rerun::Color {
     )
 }
 
-/// Record: roads and zones once, then each outdoor robot's GPS, road beliefs, route and camera.
+/// Record: roads and zones once, then each outdoor robot's GPS, road beliefs and route.
 #[allow(clippy::type_complexity)]
 pub fn record_outdoor(
     clock: Res<SimClock>,
     mut r: ResMut<RrdRecorder>,
     mut state: ResMut<OutdoorRecording>,
-    (roads, zones, surface): (
-        Option<Res<RoadMap>>,
-        Option<Res<Zones>>,
-        Option<Res<RoadSurface>>,
-    ),
-    pool: Option<Res<KernelPool>>,
+    (roads, zones): (Option<Res<RoadMap>>, Option<Res<Zones>>),
     robots: Query<(
         &RobotIndex,
         &RobotId,
         &TruePose,
         Option<&RoadLocalization>,
         Option<&RoadNavigator>,
-        Option<(&Camera, &CameraImages, &RoadDetector)>,
     )>,
 ) {
     let Some(roads) = roads else { return };
     let g = &*roads.0;
-    let empty = SurfaceRaster::empty();
     let r = &mut *r;
     let now = clock.now();
     if !state.started {
@@ -183,16 +170,12 @@ pub fn record_outdoor(
     }
     let mut sorted: Vec<_> = robots.iter().collect();
     sorted.sort_by_key(|(i, ..)| **i);
-    for (idx, id, truth, loc, nav, camera) in sorted {
+    for (idx, id, truth, loc, nav) in sorted {
         let i = idx.0 as usize;
         if state.robots.len() <= i {
             state.robots.resize(i + 1, Logged::default());
         }
-        let (camera_period, pose_period, particle_period) = (
-            state.camera_period,
-            state.pose_period,
-            state.particle_period,
-        );
+        let (pose_period, particle_period) = (state.pose_period, state.particle_period);
         let logged = &mut state.robots[i];
         let base = format!("robots/{}", id.0);
         r.rec.set_duration_secs("sim_time", now);
@@ -305,42 +288,5 @@ pub fn record_outdoor(
             logged.events = nav.events.len();
             r.rec.set_duration_secs("sim_time", now);
         }
-        if let Some((camera, images, det)) = camera
-            && images.fresh
-            && now >= logged.camera_at + camera_period - 1e-9
-            && let Some(frame) = &images.frame
-        {
-            logged.camera_at = now;
-            let raster = surface_or_grass(surface.as_deref(), &empty);
-            // the whole frame, rows in parallel on the run's kernel pool
-            let mut drawn = match &pool {
-                Some(p) => p.install(|| camera.render(frame, raster)),
-                None => camera.render(frame, raster),
-            };
-            if let Some(d) = &det.detection {
-                draw_detection(&mut drawn, d);
-            }
-            match encode_jpeg(&drawn.rgb, drawn.width, drawn.height) {
-                Ok(bytes) => {
-                    let res = r.rec.log(
-                        format!("{base}/camera"),
-                        &rerun::EncodedImage::from_file_contents(bytes)
-                            .with_media_type(rerun::MediaType::JPEG),
-                    );
-                    r.check(res);
-                }
-                Err(e) => {
-                    r.error.get_or_insert_with(|| format!("camera image: {e}"));
-                }
-            }
-        }
     }
-}
-
-/// JPEG (quality 80) of an RGB8 image.
-fn encode_jpeg(rgb: &[u8], width: u32, height: u32) -> Result<Vec<u8>, image::ImageError> {
-    let mut out = Vec::new();
-    let enc = image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, 80);
-    image::ImageEncoder::write_image(enc, rgb, width, height, image::ExtendedColorType::Rgb8)?;
-    Ok(out)
 }

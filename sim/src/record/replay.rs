@@ -7,7 +7,7 @@
 
 use super::rrd::{close_recording, open_recording, push_point};
 use super::slam::{SlamTrack, log_slam_scan, log_slam_state, slam_entity};
-use rerun::RecordingStream;
+use super::stream::RrdStream;
 use std::path::Path;
 use systems::core::Pose2;
 use systems::localization::ScanEstimator;
@@ -17,7 +17,7 @@ use systems::sensors::LaserScan;
 const SCAN_RATE: f64 = 5.0;
 
 pub struct ReplayRecorder {
-    rec: RecordingStream,
+    rec: RrdStream,
     robot: String,
     base: String,
     /// Timestamp of the log's first record (the timeline's zero).
@@ -39,7 +39,7 @@ impl ReplayRecorder {
         (t0, slam_rate): (f64, f64),
     ) -> anyhow::Result<Self> {
         Ok(ReplayRecorder {
-            rec: open_recording(path, robot)?,
+            rec: RrdStream::new(open_recording(path, robot)?),
             robot: robot.to_string(),
             base: slam_entity(robot, slam, 1),
             t0,
@@ -75,7 +75,7 @@ impl ReplayRecorder {
             && let Some(e) = est.estimate()
         {
             self.scan_at = Some(t);
-            let res = log_slam_scan(&self.rec, &self.base, scan, &e.pose.compose(mount));
+            let res = log_slam_scan(&mut self.rec, &self.base, scan, &e.pose.compose(mount));
             self.check(res);
         }
         if self.track.state_due(t) {
@@ -84,7 +84,7 @@ impl ReplayRecorder {
     }
 
     fn log_state(&mut self, est: &dyn ScanEstimator) {
-        let res = log_slam_state(&self.rec, &self.base, est);
+        let res = log_slam_state(&mut self.rec, &self.base, est);
         self.check(res);
         let grey = rerun::Color::from_rgb(150, 150, 150);
         for (leaf, path, colour) in [
@@ -107,6 +107,6 @@ impl ReplayRecorder {
     pub fn finish(mut self, est: &dyn ScanEstimator, stamp: f64) -> anyhow::Result<()> {
         self.rec.set_duration_secs("sim_time", stamp - self.t0);
         self.log_state(est);
-        close_recording(&self.rec, self.error.take())
+        close_recording(&mut self.rec, self.error.take())
     }
 }

@@ -28,6 +28,7 @@
 //! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
 
 use super::belief::{self, Cloud};
+use super::stream::RrdStream;
 use crate::scenario::RecordConfig;
 use bevy_ecs::prelude::*;
 use std::collections::VecDeque;
@@ -47,7 +48,7 @@ const TRAIL_POINTS: usize = 30;
 
 #[derive(Resource)]
 pub struct RrdRecorder {
-    pub(super) rec: rerun::RecordingStream,
+    pub(super) rec: RrdStream,
     pose_timer: RateTimer,
     scan_timer: RateTimer,
     path_timer: RateTimer,
@@ -108,7 +109,7 @@ impl RrdRecorder {
     ) -> anyhow::Result<Self> {
         let rec = open_recording(path, scenario_name)?;
         let mut r = RrdRecorder {
-            rec,
+            rec: RrdStream::new(rec),
             pose_timer: RateTimer::new(config.rate, 0.0),
             scan_timer: RateTimer::new(config.scan_rate, 0.0),
             path_timer: RateTimer::new(config.path_rate, 0.0),
@@ -155,16 +156,13 @@ impl RrdRecorder {
 
     /// Flushes everything to disk; returns the first error seen.
     pub fn finish(&mut self) -> anyhow::Result<()> {
-        close_recording(&self.rec, self.error.take())
+        close_recording(&mut self.rec, self.error.take())
     }
 }
 
 /// Flushes a recording to disk; returns `error` (the first logging error seen) or the flush's.
-pub(super) fn close_recording(
-    rec: &rerun::RecordingStream,
-    error: Option<String>,
-) -> anyhow::Result<()> {
-    let flushed = rec.flush_blocking().map_err(|e| e.to_string());
+pub(super) fn close_recording(rec: &mut RrdStream, error: Option<String>) -> anyhow::Result<()> {
+    let flushed = rec.flush_blocking();
     match error.or(flushed.err()) {
         Some(e) => Err(anyhow::anyhow!("writing the recording failed: {e}")),
         None => Ok(()),

@@ -20,8 +20,8 @@
 //! (lower `slam_rate` for long graph SLAM runs).
 
 use super::rrd::{RrdRecorder, grid_map, scan_cloud};
+use super::stream::RrdStream;
 use bevy_ecs::prelude::*;
-use rerun::RecordingStream;
 use systems::core::clock::RateTimer;
 use systems::core::{Pose2, RobotId, RobotIndex, SimClock};
 use systems::localization::{Filter, GraphEdgeKind, GraphView, Localizers, ScanEstimator};
@@ -75,7 +75,7 @@ fn xyz(p: &Pose2) -> [f32; 3] {
 
 /// Logs map, trajectory and graph of `est` under `base` at the stream's current time.
 pub fn log_slam_state(
-    rec: &RecordingStream,
+    rec: &mut RrdStream,
     base: &str,
     est: &dyn ScanEstimator,
 ) -> rerun::RecordingStreamResult<()> {
@@ -102,7 +102,7 @@ pub fn log_slam_state(
     Ok(())
 }
 
-fn log_graph(rec: &RecordingStream, base: &str, g: &GraphView) -> rerun::RecordingStreamResult<()> {
+fn log_graph(rec: &mut RrdStream, base: &str, g: &GraphView) -> rerun::RecordingStreamResult<()> {
     // accepted closures last, so they are drawn over the others
     let mut edges: Vec<_> = g
         .edges
@@ -130,7 +130,7 @@ fn log_graph(rec: &RecordingStream, base: &str, g: &GraphView) -> rerun::Recordi
 
 /// Logs the end points of `scan`, taken from `sensor` (the laser's pose in the SLAM's map frame).
 pub fn log_slam_scan(
-    rec: &RecordingStream,
+    rec: &mut RrdStream,
     base: &str,
     scan: &LaserScan,
     sensor: &Pose2,
@@ -251,14 +251,15 @@ fn record(
         for &(k, est) in &list {
             let base = slam_entity(&id.0, &locs.items[k].name, list.len());
             if all_now | s.track((idx.0, k)).state_due(now) {
-                let res = log_slam_state(&r.rec, &base, est);
+                let res = log_slam_state(&mut r.rec, &base, est);
                 r.check(res);
             }
             if scans_due
                 && let Some((scans, laser)) = laser
                 && let (Some(scan), Some(e)) = (&scans.latest, est.estimate())
             {
-                let res = log_slam_scan(&r.rec, &base, scan, &e.pose.compose(&laser.spec.mount));
+                let res =
+                    log_slam_scan(&mut r.rec, &base, scan, &e.pose.compose(&laser.spec.mount));
                 r.check(res);
             }
         }

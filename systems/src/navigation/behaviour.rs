@@ -9,7 +9,6 @@ use crate::localization::NavBelief;
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
 use rand::RngExt;
-use rayon::prelude::*;
 use std::f64::consts::PI;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -176,17 +175,14 @@ pub fn drive_behaviours(
 ) {
     let now = clock.start();
     let mut jobs: Vec<_> = robots.iter_mut().collect();
-    pool.install(|| {
-        jobs.par_iter_mut()
-            .for_each(|(b, belief, kin, cmd, laser)| {
-                if let Some((laser, scans)) = laser {
-                    if let Some(scan) = scans.scans.last() {
-                        b.sectors = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
-                    } else if !laser.enabled {
-                        b.sectors = None;
-                    }
-                }
-                **cmd = b.command(&belief.pose, now, kin);
-            });
+    pool.for_each(&mut jobs, |(b, belief, kin, cmd, laser)| {
+        if let Some((laser, scans)) = laser {
+            if let Some(scan) = scans.scans.last() {
+                b.sectors = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+            } else if !laser.enabled {
+                b.sectors = None;
+            }
+        }
+        **cmd = b.command(&belief.pose, now, kin);
     });
 }

@@ -13,7 +13,6 @@ use crate::core::{KernelPool, RobotIndex, SimClock};
 use crate::localization::NavBelief;
 use crate::sensors::{Laser, LaserScans, SonarReadings, Sonars};
 use bevy_ecs::prelude::*;
-use rayon::prelude::*;
 
 /// A sonar echo within this distance (m) of a wall the map knows in its cone is that wall (range
 /// noise, belief error, the wall's cell size).
@@ -41,11 +40,9 @@ pub fn plan_routes(
         return;
     }
     let costmaps = &*costmaps;
-    pool.install(|| {
-        jobs.par_iter_mut().for_each(|(nav, belief)| {
-            let map = costmaps.get(nav.params.costmap);
-            nav.plan(now, map, &belief.pose);
-        });
+    pool.for_each(&mut jobs, |(nav, belief)| {
+        let map = costmaps.get(nav.params.costmap);
+        nav.plan(now, map, &belief.pose);
     });
 }
 
@@ -83,60 +80,57 @@ pub fn drive_navigators(
     let (now, dt) = (clock.start(), clock.dt);
     let costmaps = &*costmaps;
     let mut jobs: Vec<_> = robots.iter_mut().collect();
-    pool.install(|| {
-        jobs.par_iter_mut()
-            .for_each(|(idx, nav, belief, cmd, laser, sonar)| {
-                // sonar echoes join the laser points of the stop check (the laser is blind
-                // behind and below its plane; the sonars cover front, ±45° and rear)
-                nav.extra.clear();
-                let costmap = costmaps.get(nav.params.costmap);
-                if let Some((sonars, readings)) = sonar
-                    && sonars.enabled
-                {
-                    for (m, &r) in sonars.mounts.iter().zip(&readings.latest) {
-                        let r = if r == f32::NEG_INFINITY {
-                            sonars.spec.min_range as f32
-                        } else {
-                            r
-                        };
-                        let sensor = belief.pose.compose(m);
-                        let explained = |r: f32| {
-                            echo_explained(
-                                costmap,
-                                &sensor,
-                                sonars.spec.cone + 2.0 * ECHO_CONE_MARGIN,
-                                sonars.spec.fan_rays() + 4,
-                                r as f64,
-                                ECHO_TOLERANCE,
-                            )
-                        };
-                        if r.is_finite() && !explained(r) {
-                            // an echo short of every wall the map knows in the cone: something is
-                            // somewhere in the cone at that range, an arc of points
-                            let half = sonars.spec.cone / 2.0;
-                            for k in 0..7 {
-                                let a = -half + half * k as f64 / 3.0;
-                                let (sa, ca) = a.sin_cos();
-                                let p = m.transform_point([r as f64 * ca, r as f64 * sa]);
-                                nav.extra.push((p[0] as f32, p[1] as f32));
-                            }
-                        }
-                    }
-                }
-                if let Some((laser, scans)) = laser {
-                    if let Some(scan) = scans.scans.last() {
-                        nav.seen = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
-                    } else if !laser.enabled {
-                        nav.seen = None;
-                    }
-                }
-                let ctx = ControlContext {
-                    now,
-                    dt,
-                    costmap,
-                    costmap_version: costmaps.version,
+    pool.for_each(&mut jobs, |(idx, nav, belief, cmd, laser, sonar)| {
+        // sonar echoes join the laser points of the stop check (the laser is blind
+        // behind and below its plane; the sonars cover front, ±45° and rear)
+        nav.extra.clear();
+        let costmap = costmaps.get(nav.params.costmap);
+        if let Some((sonars, readings)) = sonar
+            && sonars.enabled
+        {
+            for (m, &r) in sonars.mounts.iter().zip(&readings.latest) {
+                let r = if r == f32::NEG_INFINITY {
+                    sonars.spec.min_range as f32
+                } else {
+                    r
                 };
-                **cmd = nav.control(&ctx, idx.0, &belief.pose, fleet);
-            });
+                let sensor = belief.pose.compose(m);
+                let explained = |r: f32| {
+                    echo_explained(
+                        costmap,
+                        &sensor,
+                        sonars.spec.cone + 2.0 * ECHO_CONE_MARGIN,
+                        sonars.spec.fan_rays() + 4,
+                        r as f64,
+                        ECHO_TOLERANCE,
+                    )
+                };
+                if r.is_finite() && !explained(r) {
+                    // an echo short of every wall the map knows in the cone: something is
+                    // somewhere in the cone at that range, an arc of points
+                    let half = sonars.spec.cone / 2.0;
+                    for k in 0..7 {
+                        let a = -half + half * k as f64 / 3.0;
+                        let (sa, ca) = a.sin_cos();
+                        let p = m.transform_point([r as f64 * ca, r as f64 * sa]);
+                        nav.extra.push((p[0] as f32, p[1] as f32));
+                    }
+                }
+            }
+        }
+        if let Some((laser, scans)) = laser {
+            if let Some(scan) = scans.scans.last() {
+                nav.seen = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+            } else if !laser.enabled {
+                nav.seen = None;
+            }
+        }
+        let ctx = ControlContext {
+            now,
+            dt,
+            costmap,
+            costmap_version: costmaps.version,
+        };
+        **cmd = nav.control(&ctx, idx.0, &belief.pose, fleet);
     });
 }

@@ -14,7 +14,6 @@ use crate::world::StaticWorld;
 use bevy_ecs::prelude::*;
 use rand::RngExt;
 use rand_distr::StandardNormal;
-use rayon::prelude::*;
 
 /// Laser parameters (SI units, angles in radians).
 #[derive(Clone, Debug, PartialEq)]
@@ -198,54 +197,53 @@ pub fn sample_lasers(
     let mut jobs: Vec<_> = lasers.iter_mut().collect();
     let rays = world.rays();
     let outlines = &*outlines;
-    pool.install(|| {
-        jobs.par_iter_mut().for_each_init(
-            Scratch::default,
-            |s, (index, truth, laser, scans, laser_truth)| {
-                scans.scans.clear();
-                laser_truth.poses.clear();
-                let laser = &mut **laser;
-                laser.timer.due(start, end, &mut s.due);
-                if !laser.enabled {
-                    return;
-                }
-                let spec = &laser.spec;
-                let n = spec.beams();
-                for &t in &s.due {
-                    let f = ((t - start) / dt).clamp(0.0, 1.0);
-                    let sensor = truth.interpolate(f).compose(&spec.mount);
-                    let p = [sensor.x as f32, sensor.y as f32];
-                    let a0 = (sensor.theta + spec.angle_min()) as f32;
-                    let inc = spec.increment as f32;
-                    let mut ranges = vec![0f32; n];
-                    rays.cast_scan(p, a0, inc, spec.max_range as f32, &mut ranges);
-                    outlines.near(
-                        sensor.x,
-                        sensor.y,
-                        spec.max_range + 1.0,
-                        index.0,
-                        &mut s.near,
-                    );
-                    overlay_circles(p, a0, inc, &mut ranges, &s.near.circles);
-                    overlay_segments(p, a0, inc, &mut ranges, &s.near.segments);
-                    apply_noise(spec, &mut laser.rng, &mut ranges);
-                    scans.scans.push(LaserScan {
-                        stamp: t,
-                        angle_min: spec.angle_min() as f32,
-                        angle_increment: inc,
-                        range_min: spec.min_range as f32,
-                        range_max: spec.max_range as f32,
-                        ranges,
-                    });
-                    laser_truth.poses.push(sensor);
-                }
-                if let Some(last) = scans.scans.last() {
-                    scans.latest = Some(last.clone());
-                    laser_truth.latest = laser_truth.poses.last().copied();
-                }
-            },
-        );
-    });
+    pool.for_each_init(
+        &mut jobs,
+        Scratch::default,
+        |s, (index, truth, laser, scans, laser_truth)| {
+            scans.scans.clear();
+            laser_truth.poses.clear();
+            let laser = &mut **laser;
+            laser.timer.due(start, end, &mut s.due);
+            if !laser.enabled {
+                return;
+            }
+            let spec = &laser.spec;
+            let n = spec.beams();
+            for &t in &s.due {
+                let f = ((t - start) / dt).clamp(0.0, 1.0);
+                let sensor = truth.interpolate(f).compose(&spec.mount);
+                let p = [sensor.x as f32, sensor.y as f32];
+                let a0 = (sensor.theta + spec.angle_min()) as f32;
+                let inc = spec.increment as f32;
+                let mut ranges = vec![0f32; n];
+                rays.cast_scan(p, a0, inc, spec.max_range as f32, &mut ranges);
+                outlines.near(
+                    sensor.x,
+                    sensor.y,
+                    spec.max_range + 1.0,
+                    index.0,
+                    &mut s.near,
+                );
+                overlay_circles(p, a0, inc, &mut ranges, &s.near.circles);
+                overlay_segments(p, a0, inc, &mut ranges, &s.near.segments);
+                apply_noise(spec, &mut laser.rng, &mut ranges);
+                scans.scans.push(LaserScan {
+                    stamp: t,
+                    angle_min: spec.angle_min() as f32,
+                    angle_increment: inc,
+                    range_min: spec.min_range as f32,
+                    range_max: spec.max_range as f32,
+                    ranges,
+                });
+                laser_truth.poses.push(sensor);
+            }
+            if let Some(last) = scans.scans.last() {
+                scans.latest = Some(last.clone());
+                laser_truth.latest = laser_truth.poses.last().copied();
+            }
+        },
+    );
 }
 
 #[cfg(test)]

@@ -22,7 +22,6 @@ use crate::world::StaticWorld;
 use bevy_ecs::prelude::*;
 use rand::RngExt;
 use rand_distr::StandardNormal;
-use rayon::prelude::*;
 
 /// Largest angle between neighbouring rays of a sonar's fan (4°: 15 rays across the SRF02's 55°;
 /// an obstacle narrower than the gap, ~0.4 m at 6 m, can slip between rays).
@@ -223,52 +222,51 @@ pub fn sample_sonars(
     let mut jobs: Vec<_> = sonars.iter_mut().collect();
     let rays = world.rays();
     let outlines = &*outlines;
-    pool.install(|| {
-        jobs.par_iter_mut().for_each_init(
-            Scratch::default,
-            |s, (index, truth, sonars, readings, sonar_truth)| {
-                readings.fired = false;
-                let sonars = &mut **sonars;
-                sonars.timer.due(start, end, &mut s.due);
-                let Some(&t) = s.due.last() else {
-                    return;
+    pool.for_each_init(
+        &mut jobs,
+        Scratch::default,
+        |s, (index, truth, sonars, readings, sonar_truth)| {
+            readings.fired = false;
+            let sonars = &mut **sonars;
+            sonars.timer.due(start, end, &mut s.due);
+            let Some(&t) = s.due.last() else {
+                return;
+            };
+            if !sonars.enabled {
+                return;
+            }
+            let f = ((t - start) / dt).clamp(0.0, 1.0);
+            let base = truth.interpolate(f);
+            let reach = sonars
+                .mounts
+                .iter()
+                .map(|m| m.x.hypot(m.y))
+                .fold(0.0, f64::max);
+            outlines.near(
+                base.x,
+                base.y,
+                sonars.spec.max_range + reach + 1.0,
+                index.0,
+                &mut s.near,
+            );
+            let spec = &sonars.spec;
+            readings.latest.clear();
+            for m in &sonars.mounts {
+                let exact = cast_cone(rays, &s.near, spec, &base.compose(m), &mut s.fan);
+                // one draw per mount whatever it saw, so the stream's use depends only on
+                // the parameters, never on the geometry
+                let n: f64 = if spec.noise_std > 0.0 {
+                    sonars.rng.sample(StandardNormal)
+                } else {
+                    0.0
                 };
-                if !sonars.enabled {
-                    return;
-                }
-                let f = ((t - start) / dt).clamp(0.0, 1.0);
-                let base = truth.interpolate(f);
-                let reach = sonars
-                    .mounts
-                    .iter()
-                    .map(|m| m.x.hypot(m.y))
-                    .fold(0.0, f64::max);
-                outlines.near(
-                    base.x,
-                    base.y,
-                    sonars.spec.max_range + reach + 1.0,
-                    index.0,
-                    &mut s.near,
-                );
-                let spec = &sonars.spec;
-                readings.latest.clear();
-                for m in &sonars.mounts {
-                    let exact = cast_cone(rays, &s.near, spec, &base.compose(m), &mut s.fan);
-                    // one draw per mount whatever it saw, so the stream's use depends only on
-                    // the parameters, never on the geometry
-                    let n: f64 = if spec.noise_std > 0.0 {
-                        sonars.rng.sample(StandardNormal)
-                    } else {
-                        0.0
-                    };
-                    readings.latest.push(measure(spec, exact, n));
-                }
-                readings.stamp = t;
-                readings.fired = true;
-                sonar_truth.latest = Some(base);
-            },
-        );
-    });
+                readings.latest.push(measure(spec, exact, n));
+            }
+            readings.stamp = t;
+            readings.fired = true;
+            sonar_truth.latest = Some(base);
+        },
+    );
 }
 
 #[cfg(test)]

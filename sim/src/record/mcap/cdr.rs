@@ -51,6 +51,12 @@ pub fn encode<T: Serialize>(msg: &T) -> Vec<u8> {
 /// [`encode`] into a buffer (cleared first), to reuse its allocation.
 pub fn encode_into<T: Serialize>(out: &mut Vec<u8>, msg: &T) {
     out.clear();
+    encode_append(out, msg);
+}
+
+/// [`encode`] appended to `out` (whatever it holds stays in front): for gathering several
+/// payloads in one buffer.
+pub fn encode_append<T: Serialize>(out: &mut Vec<u8>, msg: &T) {
     out.extend_from_slice(&CDR_LE_HEADER);
     cdr_encoding::to_writer::<T, LittleEndian, _>(&mut *out, msg)
         .expect("ROS message types serialize to CDR");

@@ -137,7 +137,7 @@ fn an_interrupted_writer_leaves_its_flushed_chunks_readable() {
         rec.write(cam, i * SEC, &samples::image(i as f64, 320, 240))
             .unwrap();
     }
-    std::mem::forget(rec); // the process dies: no summary, unflushed bytes lost
+    rec.abandon(); // the process dies: no summary, unflushed bytes lost
     let e = McapRecording::open(&path).unwrap_err().to_string();
     assert!(
         e.starts_with(&format!("{}: truncated MCAP file", path.display())),
@@ -231,4 +231,51 @@ fn garbage_and_flipped_bytes_are_errors_not_panics() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("missing.mcap: cannot read"), "{e}");
+}
+
+/// A file that takes `room` bytes, then fails every write with "no space left".
+struct FillingDisk {
+    data: std::io::Cursor<Vec<u8>>,
+    room: usize,
+}
+
+impl std::io::Write for FillingDisk {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.data.get_ref().len() + buf.len() > self.room {
+            return Err(std::io::Error::from(std::io::ErrorKind::StorageFull));
+        }
+        self.data.write(buf)
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+impl std::io::Seek for FillingDisk {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.data.seek(pos)
+    }
+}
+
+#[test]
+fn a_write_error_is_reported_by_flush_and_by_finish() {
+    let disk = FillingDisk {
+        data: Default::default(),
+        room: 8_000,
+    };
+    let path = Path::new("full.mcap");
+    let mut rec = McapRecorder::create_on(path, Box::new(disk), ROS2_PROFILE).unwrap();
+    let scan = rec.channel::<LaserScan>("/scan").unwrap();
+    for i in 0..400 {
+        // the writer thread fails on the way; writing goes on without an error here
+        rec.write(scan, i * SEC, &samples::laser_scan(i as f64, 720))
+            .unwrap();
+    }
+    let e = format!("{:#}", rec.flush().unwrap_err());
+    assert!(e.starts_with("full.mcap: cannot "), "{e}");
+    assert!(e.contains("I/O error"), "{e}");
+    rec.write(scan, 401 * SEC, &samples::laser_scan(401.0, 720))
+        .unwrap();
+    let e2 = format!("{:#}", rec.finish().unwrap_err());
+    assert_eq!(e2, e, "the first error again");
 }

@@ -9,6 +9,12 @@
 //! complete chunks [`super::McapRecording::open_recovering`] reads back. [`McapRecorder::finish`]
 //! writes the summary (schemas, channels, statistics, chunk and attachment indexes) and the
 //! footer; dropping the recorder without it does the same, ignoring errors.
+//!
+//! Threads: the caller only encodes messages (CDR) into a batch; compression, checksums and
+//! file writes happen on a writer thread of the recorder, which takes the batches in order
+//! (at most [`QUEUED_BATCHES`] waiting, so memory stays bounded). The file is the same as if
+//! written on the caller's thread. A write error is reported by the next
+//! [`McapRecorder::flush`] or by [`McapRecorder::finish`]; nothing is written after it.
 
 use super::cdr;
 use super::schema::{RosMessage, SCHEMA_ENCODING};
@@ -18,6 +24,8 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::thread::JoinHandle;
 
 /// The MCAP profile of ROS 2 recordings.
 pub const ROS2_PROFILE: &str = "ros2";
@@ -25,6 +33,16 @@ pub const ROS2_PROFILE: &str = "ros2";
 pub const MESSAGE_ENCODING: &str = "cdr";
 /// Default automatic flush period (ns of log time).
 pub const DEFAULT_FLUSH_PERIOD_NS: u64 = 10_000_000_000;
+/// A batch goes to the writer thread when its payloads reach this size (bytes) ...
+const BATCH_BYTES: usize = 256 * 1024;
+/// ... or it holds this many operations.
+const BATCH_OPS: usize = 2048;
+/// Batches waiting for the writer thread at most (the caller waits when there are more).
+pub const QUEUED_BATCHES: usize = 8;
+
+/// Where an MCAP file goes: a file, or a test's stand-in.
+pub(crate) trait Output: std::io::Write + std::io::Seek + Send {}
+impl<T: std::io::Write + std::io::Seek + Send> Output for T {}
 
 /// A registered topic whose messages are of type `T`.
 pub struct Channel<T> {
@@ -58,17 +76,53 @@ pub struct McapStats {
 /// An MCAP file being written. See the module doc.
 pub struct McapRecorder {
     path: PathBuf,
-    writer: mcap::Writer<BufWriter<File>>,
     /// Schema id per schema name.
     schemas: HashMap<&'static str, u16>,
     /// (channel id, schema name) per topic.
     topics: HashMap<String, (u16, &'static str)>,
-    /// Next sequence number per channel id.
-    sequences: HashMap<u16, u32>,
-    buf: Vec<u8>,
-    flush_period_ns: Option<u64>,
-    last_flush_ns: Option<u64>,
-    latest_ns: u64,
+    /// What is gathered for the writer thread.
+    batch: Batch,
+    jobs: Option<mpsc::SyncSender<Batch>>,
+    worker: Option<JoinHandle<anyhow::Result<McapStats>>>,
+}
+
+/// Operations for the writer thread, in order; message payloads lie in [`Batch::data`].
+#[derive(Default)]
+struct Batch {
+    ops: Vec<Op>,
+    data: Vec<u8>,
+}
+
+type Reply<T> = mpsc::Sender<anyhow::Result<T>>;
+
+enum Op {
+    /// A message whose payload ends at `end` in the batch's data (and starts where the
+    /// previous message's ended, or at 0).
+    Message {
+        channel: u16,
+        log_time: u64,
+        end: usize,
+    },
+    Schema {
+        name: &'static str,
+        definition: &'static str,
+        reply: Reply<u16>,
+    },
+    Channel {
+        schema: u16,
+        topic: String,
+        reply: Reply<u16>,
+    },
+    Attach {
+        name: String,
+        media_type: String,
+        data: Vec<u8>,
+    },
+    FlushPeriod(Option<u64>),
+    Flush(Reply<()>),
+    /// Stop as a dying process would: no summary, buffered bytes lost (tests).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Abandon,
 }
 
 impl McapRecorder {
@@ -77,6 +131,15 @@ impl McapRecorder {
     pub fn create(path: &Path, profile: &str) -> anyhow::Result<Self> {
         let file = File::create(path)
             .map_err(|e| anyhow!("{}: cannot create the MCAP file: {e}", path.display()))?;
+        Self::create_on(path, Box::new(file), profile)
+    }
+
+    /// [`McapRecorder::create`] writing to `out` (`path` names it in messages).
+    pub(crate) fn create_on(
+        path: &Path,
+        out: Box<dyn Output>,
+        profile: &str,
+    ) -> anyhow::Result<Self> {
         let options = mcap::WriteOptions::new()
             .profile(profile)
             .library(format!(
@@ -86,24 +149,34 @@ impl McapRecorder {
             ))
             .compression(Some(mcap::Compression::Lz4));
         let writer = options
-            .create(BufWriter::with_capacity(1 << 16, file))
+            .create(BufWriter::with_capacity(1 << 16, out))
             .map_err(|e| anyhow!("{}: cannot start the MCAP file: {e}", path.display()))?;
-        Ok(McapRecorder {
+        let file = FileWriter {
             path: path.to_path_buf(),
             writer,
-            schemas: HashMap::new(),
-            topics: HashMap::new(),
             sequences: HashMap::new(),
-            buf: Vec::new(),
             flush_period_ns: Some(DEFAULT_FLUSH_PERIOD_NS),
             last_flush_ns: None,
             latest_ns: 0,
+        };
+        let (jobs, queue) = mpsc::sync_channel(QUEUED_BATCHES);
+        let worker = std::thread::Builder::new()
+            .name("mcap writer".into())
+            .spawn(move || file.run(queue))
+            .map_err(|e| anyhow!("{}: cannot start the writer thread: {e}", path.display()))?;
+        Ok(McapRecorder {
+            path: path.to_path_buf(),
+            schemas: HashMap::new(),
+            topics: HashMap::new(),
+            batch: Batch::default(),
+            jobs: Some(jobs),
+            worker: Some(worker),
         })
     }
 
     /// Sets the automatic flush period in ns of log time (`None`: only explicit flushes).
     pub fn set_flush_period(&mut self, period_ns: Option<u64>) {
-        self.flush_period_ns = period_ns;
+        self.batch.ops.push(Op::FlushPeriod(period_ns));
     }
 
     /// The file being written.
@@ -111,8 +184,35 @@ impl McapRecorder {
         &self.path
     }
 
-    fn error(&self, what: &str, e: impl std::fmt::Display) -> anyhow::Error {
-        anyhow!("{}: cannot {what}: {e}", self.path.display())
+    /// Hands the batch to the writer thread; an error if the thread has ended (its own error).
+    fn send(&mut self) -> anyhow::Result<()> {
+        if self.batch.ops.is_empty() {
+            return Ok(());
+        }
+        let batch = std::mem::take(&mut self.batch);
+        let sent = self.jobs.as_ref().is_some_and(|j| j.send(batch).is_ok());
+        if sent { Ok(()) } else { Err(self.stopped()) }
+    }
+
+    /// Why the writer thread is gone.
+    fn stopped(&mut self) -> anyhow::Error {
+        self.jobs = None;
+        match self.worker.take().map(JoinHandle::join) {
+            Some(Ok(Err(e))) => e,
+            Some(Err(_)) => anyhow!("{}: the MCAP writer thread panicked", self.path.display()),
+            _ => anyhow!("{}: the MCAP writer has stopped", self.path.display()),
+        }
+    }
+
+    /// Sends `op` with the batch and waits for the writer thread's answer.
+    fn ask<T>(&mut self, op: impl FnOnce(Reply<T>) -> Op) -> anyhow::Result<T> {
+        let (reply, answer) = mpsc::channel();
+        self.batch.ops.push(op(reply));
+        self.send()?;
+        match answer.recv() {
+            Ok(result) => result,
+            Err(_) => Err(self.stopped()),
+        }
     }
 
     /// Registers `topic` for messages of type `T` (the schema is written once per type).
@@ -135,21 +235,20 @@ impl McapRecorder {
         let schema = match self.schemas.get(T::NAME) {
             Some(&id) => id,
             None => {
-                let id = self
-                    .writer
-                    .add_schema(T::NAME, SCHEMA_ENCODING, T::DEFINITION.as_bytes())
-                    .map_err(|e| self.error(&format!("add the schema {}", T::NAME), e))?;
+                let id = self.ask(|reply| Op::Schema {
+                    name: T::NAME,
+                    definition: T::DEFINITION,
+                    reply,
+                })?;
                 self.schemas.insert(T::NAME, id);
                 id
             }
         };
-        // The `ros2` profile requires this key; empty means "no recorded QoS", which rosbag2
-        // reads as its default profile.
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), String::new())]);
-        let id = self
-            .writer
-            .add_channel(schema, topic, MESSAGE_ENCODING, &metadata)
-            .map_err(|e| self.error(&format!("add the channel {topic}"), e))?;
+        let id = self.ask(|reply| Op::Channel {
+            schema,
+            topic: topic.to_string(),
+            reply,
+        })?;
         self.topics.insert(topic.to_string(), (id, T::NAME));
         Ok(Channel {
             id,
@@ -165,25 +264,14 @@ impl McapRecorder {
         log_time_ns: u64,
         msg: &T,
     ) -> anyhow::Result<()> {
-        cdr::encode_into(&mut self.buf, msg);
-        let seq = self.sequences.entry(channel.id).or_insert(0);
-        let header = mcap::records::MessageHeader {
-            channel_id: channel.id,
-            sequence: *seq,
+        cdr::encode_append(&mut self.batch.data, msg);
+        self.batch.ops.push(Op::Message {
+            channel: channel.id,
             log_time: log_time_ns,
-            publish_time: log_time_ns,
-        };
-        *seq = seq.wrapping_add(1);
-        self.writer
-            .write_to_known_channel(&header, &self.buf)
-            .map_err(|e| anyhow!("{}: cannot write a message: {e}", self.path.display()))?;
-        self.latest_ns = self.latest_ns.max(log_time_ns);
-        let last = *self.last_flush_ns.get_or_insert(log_time_ns);
-        if self
-            .flush_period_ns
-            .is_some_and(|p| log_time_ns.saturating_sub(last) >= p)
-        {
-            self.flush()?;
+            end: self.batch.data.len(),
+        });
+        if self.batch.data.len() >= BATCH_BYTES || self.batch.ops.len() >= BATCH_OPS {
+            self.send()?;
         }
         Ok(())
     }
@@ -191,6 +279,174 @@ impl McapRecorder {
     /// Adds an attachment (e.g. the resolved scenario, `application/toml`), stamped with the
     /// latest log time written so far. Ends the current chunk.
     pub fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> anyhow::Result<()> {
+        self.batch.ops.push(Op::Attach {
+            name: name.to_string(),
+            media_type: media_type.to_string(),
+            data: data.to_vec(),
+        });
+        Ok(())
+    }
+
+    /// Ends the current chunk and hands everything written to the OS, so the file is readable
+    /// up to here even if the process dies next; the first write error so far, if any.
+    pub fn flush(&mut self) -> anyhow::Result<()> {
+        self.ask(Op::Flush)
+    }
+
+    /// Writes the summary and the footer and closes the file.
+    pub fn finish(mut self) -> anyhow::Result<McapStats> {
+        self.send()?;
+        self.jobs = None;
+        match self.worker.take().map(JoinHandle::join) {
+            Some(Ok(result)) => result,
+            _ => Err(anyhow!(
+                "{}: the MCAP writer thread panicked",
+                self.path.display()
+            )),
+        }
+    }
+
+    /// Stops writing as a process that dies here would: what the writer thread had ended
+    /// (flushed chunks) stays, the rest is lost, and there is no summary.
+    #[cfg(test)]
+    pub(crate) fn abandon(mut self) {
+        self.batch.ops.push(Op::Abandon);
+        let _ = self.send();
+        self.jobs = None;
+        if let Some(w) = self.worker.take() {
+            let _ = w.join();
+        }
+    }
+}
+
+impl Drop for McapRecorder {
+    /// Finishes the file as [`McapRecorder::finish`] does, ignoring errors.
+    fn drop(&mut self) {
+        let _ = self.send();
+        self.jobs = None;
+        if let Some(w) = self.worker.take() {
+            let _ = w.join();
+        }
+    }
+}
+
+/// The writer thread's side: the `mcap` writer and what the flush period needs.
+struct FileWriter {
+    path: PathBuf,
+    writer: mcap::Writer<BufWriter<Box<dyn Output>>>,
+    /// Next sequence number per channel id.
+    sequences: HashMap<u16, u32>,
+    flush_period_ns: Option<u64>,
+    last_flush_ns: Option<u64>,
+    latest_ns: u64,
+}
+
+impl FileWriter {
+    /// The writer thread: the batches in order until the recorder hangs up, then the summary.
+    fn run(mut self, queue: mpsc::Receiver<Batch>) -> anyhow::Result<McapStats> {
+        let mut error: Option<anyhow::Error> = None;
+        for batch in queue {
+            let mut start = 0;
+            for op in batch.ops {
+                match op {
+                    Op::Message {
+                        channel,
+                        log_time,
+                        end,
+                    } => {
+                        let data = &batch.data[start..end];
+                        start = end;
+                        if error.is_none() {
+                            error = self.message(channel, log_time, data).err();
+                        }
+                    }
+                    Op::Abandon => {
+                        std::mem::forget(self);
+                        return Err(anyhow!("abandoned"));
+                    }
+                    Op::FlushPeriod(p) => self.flush_period_ns = p,
+                    Op::Attach {
+                        name,
+                        media_type,
+                        data,
+                    } => {
+                        if error.is_none() {
+                            error = self.attach(&name, &media_type, &data).err();
+                        }
+                    }
+                    Op::Flush(reply) => {
+                        let r = match &error {
+                            Some(e) => Err(anyhow!("{e:#}")),
+                            None => self.flush(),
+                        };
+                        if let (None, Err(e)) = (&error, &r) {
+                            error = Some(anyhow!("{e:#}"));
+                        }
+                        let _ = reply.send(r);
+                    }
+                    Op::Schema {
+                        name,
+                        definition,
+                        reply,
+                    } => {
+                        let r = self
+                            .writer
+                            .add_schema(name, SCHEMA_ENCODING, definition.as_bytes())
+                            .map_err(|e| self.error(&format!("add the schema {name}"), e));
+                        let _ = reply.send(r);
+                    }
+                    Op::Channel {
+                        schema,
+                        topic,
+                        reply,
+                    } => {
+                        // The `ros2` profile requires this key; empty means "no recorded QoS",
+                        // which rosbag2 reads as its default profile.
+                        let metadata =
+                            BTreeMap::from([("offered_qos_profiles".to_string(), String::new())]);
+                        let r = self
+                            .writer
+                            .add_channel(schema, &topic, MESSAGE_ENCODING, &metadata)
+                            .map_err(|e| self.error(&format!("add the channel {topic}"), e));
+                        let _ = reply.send(r);
+                    }
+                }
+            }
+        }
+        match error {
+            Some(e) => Err(e),
+            None => self.finish(),
+        }
+    }
+
+    fn error(&self, what: &str, e: impl std::fmt::Display) -> anyhow::Error {
+        anyhow!("{}: cannot {what}: {e}", self.path.display())
+    }
+
+    fn message(&mut self, channel: u16, log_time: u64, data: &[u8]) -> anyhow::Result<()> {
+        let seq = self.sequences.entry(channel).or_insert(0);
+        let header = mcap::records::MessageHeader {
+            channel_id: channel,
+            sequence: *seq,
+            log_time,
+            publish_time: log_time,
+        };
+        *seq = seq.wrapping_add(1);
+        self.writer
+            .write_to_known_channel(&header, data)
+            .map_err(|e| self.error("write a message", e))?;
+        self.latest_ns = self.latest_ns.max(log_time);
+        let last = *self.last_flush_ns.get_or_insert(log_time);
+        if self
+            .flush_period_ns
+            .is_some_and(|p| log_time.saturating_sub(last) >= p)
+        {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> anyhow::Result<()> {
         let attachment = mcap::Attachment {
             log_time: self.latest_ns,
             create_time: self.latest_ns,
@@ -203,20 +459,17 @@ impl McapRecorder {
             .map_err(|e| self.error(&format!("attach {name}"), e))
     }
 
-    /// Ends the current chunk and hands everything written to the OS, so the file is readable
-    /// up to here even if the process dies next.
-    pub fn flush(&mut self) -> anyhow::Result<()> {
+    fn flush(&mut self) -> anyhow::Result<()> {
         self.last_flush_ns = Some(self.latest_ns);
         self.writer.flush().map_err(|e| self.error("flush", e))
     }
 
-    /// Writes the summary and the footer and closes the file.
-    pub fn finish(mut self) -> anyhow::Result<McapStats> {
+    fn finish(mut self) -> anyhow::Result<McapStats> {
         let summary = self
             .writer
             .finish()
             .map_err(|e| self.error("finish the MCAP file", e))?;
-        let McapRecorder { path, writer, .. } = self;
+        let FileWriter { path, writer, .. } = self;
         writer.into_inner().into_inner().map_err(|e| {
             anyhow!(
                 "{}: cannot write the MCAP file: {}",

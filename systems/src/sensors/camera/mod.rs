@@ -27,6 +27,7 @@ use bevy_ecs::prelude::*;
 use rand::RngExt;
 use rand_distr::StandardNormal;
 pub use render::{FrameParams, FrameView, Palette, render_ground};
+use std::sync::Arc;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraSpec {
@@ -182,15 +183,15 @@ pub struct Camera {
     pub enabled: bool,
     pub palette: Palette,
     /// Derived from `spec` by [`Camera::new`]; rebuild with [`GroundRays::new`] if the spec
-    /// changes.
-    pub rays: GroundRays,
+    /// changes. Shared, so recorders can render frames on another thread.
+    pub rays: Arc<GroundRays>,
 }
 
 impl Camera {
     pub fn new(spec: CameraSpec, rng: SimRng) -> Self {
         Camera {
             timer: RateTimer::new(spec.rate, 0.0),
-            rays: GroundRays::new(&spec),
+            rays: Arc::new(GroundRays::new(&spec)),
             palette: Palette::default(),
             spec,
             rng,

@@ -106,6 +106,19 @@ fn floor_i32(v: f32) -> i32 {
     if (i as f32) > v { i - 1 } else { i }
 }
 
+/// The ground-fixed mottle of cell (ix, iy), in [-0.5, 0.5): hashes of the 0.4 m and 0.1 m
+/// cells it lies in.
+#[inline(always)]
+fn mottle(ix: i32, iy: i32) -> f32 {
+    0.65 * cell_hash(ix >> 3, iy >> 3) + 0.35 * cell_hash(ix >> 1, iy >> 1) - 0.5
+}
+
+/// Whether cell (ix, iy) lies on a joint between paving stones (every 0.2 m).
+#[inline(always)]
+fn joint(ix: i32, iy: i32) -> bool {
+    (ix & 3) == 0 || (iy & 3) == 0
+}
+
 /// Standard deviation of the sum of two independent uniform bytes minus 255.
 const TRIANGULAR_STD: f32 = 104.52;
 
@@ -181,6 +194,16 @@ impl<'a> FrameView<'a> {
     /// `width × height × 3` bytes. Rows render in parallel on the caller's rayon pool; the
     /// image does not depend on the thread count.
     pub fn render(&self, out: &mut [u8]) {
+        self.render_rows(out, true);
+    }
+
+    /// [`FrameView::render`] on the calling thread alone (for a thread of its own, such as a
+    /// recorder's): the same bytes.
+    pub fn render_here(&self, out: &mut [u8]) {
+        self.render_rows(out, false);
+    }
+
+    fn render_rows(&self, out: &mut [u8], parallel: bool) {
         let (w, h) = (self.rays.width as usize, self.rays.height as usize);
         assert_eq!(out.len(), w * h * 3, "output buffer size");
         let first = (self.rays.first_ground_row as usize).min(h);
@@ -191,18 +214,40 @@ impl<'a> FrameView<'a> {
                 px.copy_from_slice(&self.shade(c, v * w + u));
             }
         }
+        // in blocks: first every pixel's cell (independent raster reads the CPU overlaps),
+        // then the colours
         let render_row = |(row, (line, offsets)): (usize, (&mut [u8], &[[f32; 2]]))| {
-            let i0 = (first + row) * w;
-            for (u, (px, ray)) in line.chunks_exact_mut(3).zip(offsets).enumerate() {
-                px.copy_from_slice(&self.ground(ray, i0 + u));
+            let mut i = (first + row) * w;
+            let mut cells = [(0, 0, 0); BLOCK];
+            // neighbouring pixels near the camera see the same cell: its mottle once
+            let mut last = (i32::MIN, i32::MIN, 0.0);
+            for (px, rays) in line.chunks_mut(3 * BLOCK).zip(offsets.chunks(BLOCK)) {
+                for (c, ray) in cells.iter_mut().zip(rays) {
+                    *c = self.cell(ray);
+                }
+                for (px, &(ix, iy, class)) in px.chunks_exact_mut(3).zip(&cells) {
+                    if (ix, iy) != (last.0, last.1) {
+                        last = (ix, iy, mottle(ix, iy));
+                    }
+                    px.copy_from_slice(&self.coloured(class, last.2, joint(ix, iy), i));
+                    i += 1;
+                }
             }
         };
-        ground
-            .par_chunks_mut(3 * w)
-            .zip(self.rays.offsets.par_chunks(w))
-            .enumerate()
-            .with_min_len(ROWS_PER_TASK)
-            .for_each(render_row);
+        if parallel {
+            ground
+                .par_chunks_mut(3 * w)
+                .zip(self.rays.offsets.par_chunks(w))
+                .enumerate()
+                .with_min_len(ROWS_PER_TASK)
+                .for_each(render_row);
+        } else {
+            ground
+                .chunks_mut(3 * w)
+                .zip(self.rays.offsets.chunks(w))
+                .enumerate()
+                .for_each(render_row);
+        }
     }
 
     /// The sky's colour in row `v` (above the horizon): a gradient down to the horizon.
@@ -218,8 +263,14 @@ impl<'a> FrameView<'a> {
     }
 
     /// The ground colour under ray `ray` (robot frame offset, m), for pixel index `i`.
-    #[inline]
+    #[inline(always)]
     fn ground(&self, ray: &[f32; 2], i: usize) -> [u8; 3] {
+        self.colour(self.cell(ray), i)
+    }
+
+    /// The raster cell under ray `ray` and its surface class.
+    #[inline(always)]
+    fn cell(&self, ray: &[f32; 2]) -> (i32, i32, u8) {
         let [r00, r01, r10, r11] = self.r;
         let fx = self.o[0] + r00 * ray[0] + r01 * ray[1];
         let fy = self.o[1] + r10 * ray[0] + r11 * ray[1];
@@ -229,9 +280,21 @@ impl<'a> FrameView<'a> {
         } else {
             GRASS
         };
+        (ix, iy, class)
+    }
+
+    /// The colour of pixel index `i` seeing cell (ix, iy) of class `class`.
+    #[inline(always)]
+    fn colour(&self, (ix, iy, class): (i32, i32, u8), i: usize) -> [u8; 3] {
+        self.coloured(class, mottle(ix, iy), joint(ix, iy), i)
+    }
+
+    /// The colour of pixel index `i` seeing a cell of class `class` with mottle `m`
+    /// ([`mottle`]) on a paving joint or not ([`joint`]).
+    #[inline(always)]
+    fn coloured(&self, class: u8, m: f32, on_joint: bool, i: usize) -> [u8; 3] {
         let cc = &self.palette.classes[class as usize];
-        let m = 0.65 * cell_hash(ix >> 3, iy >> 3) + 0.35 * cell_hash(ix >> 1, iy >> 1) - 0.5;
-        let j_factor = if cc.joints != 1.0 && ((ix & 3) == 0 || (iy & 3) == 0) {
+        let j_factor = if cc.joints != 1.0 && on_joint {
             cc.joints
         } else {
             1.0
@@ -242,7 +305,7 @@ impl<'a> FrameView<'a> {
     }
 
     /// Colour `c` of pixel index `i` with the frame's brightness and the pixel's own noise.
-    #[inline]
+    #[inline(always)]
     fn shade(&self, c: [f32; 3], i: usize) -> [u8; 3] {
         let n = mix64(self.frame.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
         std::array::from_fn(|k| {
@@ -266,6 +329,9 @@ pub fn render_ground(
 ) {
     FrameView::new(rays, pose, raster, palette, *frame).render(out);
 }
+
+/// Pixels whose cells are looked up before their colours are computed.
+const BLOCK: usize = 32;
 
 /// Image rows rendered per rayon task.
 const ROWS_PER_TASK: usize = 8;

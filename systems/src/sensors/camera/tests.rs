@@ -133,6 +133,12 @@ fn same_seed_same_image() {
             "{threads} threads"
         );
     }
+    // ... nor on whether it is rendered on the calling thread alone
+    let mut cam = Camera::new(CameraSpec::default(), stream_rng(5, "r", "camera"));
+    let frame = cam.take(0.0, pose);
+    let mut here = vec![0; a.rgb.len()];
+    cam.view(&frame, raster).pixels.render_here(&mut here);
+    assert_eq!(here, a.rgb);
 }
 
 #[test]

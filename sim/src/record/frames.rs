@@ -1,0 +1,389 @@
+//! Whole camera frames for the recordings: the .rrd's JPEG (with the recognized road drawn in)
+//! and the MCAP's raw `sensor_msgs/Image`. A run computes only the pixels its road recognizer
+//! reads; a recorded frame needs all of them (~1.5 ms for 320×240) and, for the .rrd, a JPEG
+//! encoding (~0.5 ms). Both happen on a worker thread of the recording, so the simulation does
+//! not wait for them; with both outputs a frame is rendered once.
+//!
+//! Which frames: a camera's frame is recorded when it is at least `1 / record.camera_rate`
+//! after the last one recorded (the first frame always).
+//!
+//! Determinism: a frame is handed to the recorders in the first tick at least
+//! [`COLLECT_AFTER`] of simulated time after it was taken (the tick waits for the worker if it
+//! is behind), or when the run ends; so what is written, and in which order, does not depend on
+//! the worker's speed. The messages of an MCAP file are therefore not in log-time order (a frame
+//! follows a second of other messages); readers order them by their log time.
+
+use super::rrd::RrdRecorder;
+use bevy_ecs::prelude::*;
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex, mpsc};
+use std::thread::JoinHandle;
+use systems::core::{RobotId, RobotIndex, SimClock};
+use systems::navigation::road_recognition::{RoadDetection, RoadDetector, draw_detection};
+use systems::sensors::camera::{CameraFrame, CameraImage, FrameView, GroundRays, Palette};
+use systems::sensors::{Camera, CameraImages};
+use systems::world::roads::{RoadSurface, SurfaceRaster};
+
+/// Simulated time (s) the worker has to finish a frame before the run waits for it.
+pub const COLLECT_AFTER: f64 = 1.0;
+
+/// JPEG quality of the .rrd's frames.
+const JPEG_QUALITY: u8 = 80;
+
+/// What the recorders want of each frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameOutputs {
+    /// The frame as taken (MCAP).
+    pub raw: bool,
+    /// A JPEG with the road detection drawn in (.rrd).
+    pub jpeg: bool,
+}
+
+/// One recorded frame.
+#[derive(Debug)]
+pub struct RecordedFrame {
+    pub robot: RobotIndex,
+    /// The robot's name.
+    pub name: String,
+    pub stamp: f64,
+    /// The image as the camera took it, if [`FrameOutputs::raw`].
+    pub raw: Option<CameraImage>,
+    /// The JPEG (or why it failed), if [`FrameOutputs::jpeg`].
+    pub jpeg: Option<Result<Vec<u8>, String>>,
+}
+
+/// A frame to render.
+struct Job {
+    robot: RobotIndex,
+    name: String,
+    frame: CameraFrame,
+    rays: Arc<GroundRays>,
+    palette: Palette,
+    raster: Arc<SurfaceRaster>,
+    detection: Option<RoadDetection>,
+}
+
+/// The frames being recorded (a resource while a run with a recording lasts).
+#[derive(Resource)]
+pub struct RecordedFrames {
+    period: f64,
+    outputs: FrameOutputs,
+    /// Per robot (by index): the stamp of the last frame sent to the worker.
+    last: Vec<Option<f64>>,
+    jobs: Option<mpsc::Sender<Job>>,
+    /// In a mutex only because a resource must be `Sync`; reached through `&mut`.
+    done: Mutex<mpsc::Receiver<RecordedFrame>>,
+    worker: Option<JoinHandle<()>>,
+    /// Stamps of the frames sent and not yet collected, oldest first.
+    in_flight: VecDeque<f64>,
+    /// Grass everywhere, for scenarios without roads.
+    grass: Arc<SurfaceRaster>,
+    /// The frames collected in this tick, oldest first, for the recorders.
+    pub ready: Vec<RecordedFrame>,
+    /// The worker stopped early (it panicked); reported when the run ends.
+    pub error: Option<String>,
+}
+
+impl RecordedFrames {
+    /// Starts the worker thread. `camera_rate`: recorded frames per second and camera.
+    pub fn new(camera_rate: f64, outputs: FrameOutputs) -> anyhow::Result<Self> {
+        let (jobs, queue) = mpsc::channel::<Job>();
+        let (finished, done) = mpsc::channel();
+        let worker = std::thread::Builder::new()
+            .name("camera frames".into())
+            .spawn(move || {
+                for job in queue {
+                    if finished.send(render(job, outputs)).is_err() {
+                        break;
+                    }
+                }
+            })?;
+        Ok(RecordedFrames {
+            period: 1.0 / camera_rate,
+            outputs,
+            last: Vec::new(),
+            jobs: Some(jobs),
+            done: Mutex::new(done),
+            worker: Some(worker),
+            in_flight: VecDeque::new(),
+            grass: Arc::new(SurfaceRaster::empty()),
+            ready: Vec::new(),
+            error: None,
+        })
+    }
+
+    /// Collects the frames taken at or before `until` (all with `None`), waiting for the worker
+    /// as needed, into [`RecordedFrames::ready`].
+    fn collect(&mut self, until: Option<f64>) {
+        let done = self.done.get_mut().unwrap_or_else(|e| e.into_inner());
+        while let Some(&stamp) = self.in_flight.front() {
+            if until.is_some_and(|t| stamp > t) {
+                break;
+            }
+            self.in_flight.pop_front();
+            match done.recv() {
+                Ok(frame) => self.ready.push(frame),
+                Err(_) => {
+                    self.error.get_or_insert_with(|| {
+                        "the camera frame worker stopped before rendering every frame".into()
+                    });
+                    self.in_flight.clear();
+                }
+            }
+        }
+    }
+
+    /// Whether a frame of `robot` taken at `stamp` is to be recorded.
+    fn due(&self, robot: RobotIndex, stamp: f64) -> bool {
+        let last = self.last.get(robot.0 as usize).copied().flatten();
+        last.is_none_or(|last| stamp >= last + self.period - 1e-9)
+    }
+
+    /// Sends a due frame to the worker.
+    fn submit(&mut self, job: Job) {
+        let i = job.robot.0 as usize;
+        if self.last.len() <= i {
+            self.last.resize(i + 1, None);
+        }
+        let stamp = job.frame.stamp;
+        self.last[i] = Some(stamp);
+        let Some(jobs) = &self.jobs else { return };
+        if jobs.send(job).is_ok() {
+            self.in_flight.push_back(stamp);
+        } else {
+            self.error.get_or_insert_with(|| {
+                "the camera frame worker stopped before rendering every frame".into()
+            });
+        }
+    }
+
+    /// The run is over: the frames still being rendered, oldest first; the worker ends.
+    pub fn finish(mut self) -> (Vec<RecordedFrame>, Option<String>) {
+        self.ready.clear();
+        self.jobs = None;
+        self.collect(None);
+        if let Some(w) = self.worker.take()
+            && w.join().is_err()
+        {
+            self.error
+                .get_or_insert_with(|| "the camera frame worker panicked".into());
+        }
+        (std::mem::take(&mut self.ready), self.error.take())
+    }
+}
+
+/// Renders (and encodes) one frame; on the worker thread.
+fn render(job: Job, outputs: FrameOutputs) -> RecordedFrame {
+    let (w, h) = (job.rays.width, job.rays.height);
+    let mut image = CameraImage::new(w, h);
+    image.stamp = job.frame.stamp;
+    FrameView::new(
+        &job.rays,
+        job.frame.pose,
+        &job.raster,
+        &job.palette,
+        job.frame.params,
+    )
+    .render_here(&mut image.rgb);
+    let raw = outputs.raw.then(|| image.clone());
+    let jpeg = outputs.jpeg.then(|| {
+        if let Some(d) = &job.detection {
+            draw_detection(&mut image, d);
+        }
+        encode_jpeg(&image)
+    });
+    RecordedFrame {
+        robot: job.robot,
+        name: job.name,
+        stamp: job.frame.stamp,
+        raw,
+        jpeg,
+    }
+}
+
+/// JPEG of an RGB8 image.
+fn encode_jpeg(image: &CameraImage) -> Result<Vec<u8>, String> {
+    let (Ok(w), Ok(h)) = (u16::try_from(image.width), u16::try_from(image.height)) else {
+        return Err(format!(
+            "a {}×{} image is too large for a JPEG",
+            image.width, image.height
+        ));
+    };
+    let mut out = Vec::new();
+    jpeg_encoder::Encoder::new(&mut out, JPEG_QUALITY)
+        .encode(&image.rgb, w, h, jpeg_encoder::ColorType::Rgb)
+        .map_err(|e| format!("camera image: {e}"))?;
+    Ok(out)
+}
+
+/// Record set, before the recorders: hands them the frames due this tick
+/// ([`RecordedFrames::ready`]) and sends this tick's fresh frames to the worker.
+pub fn collect_frames(
+    clock: Res<SimClock>,
+    frames: ResMut<RecordedFrames>,
+    surface: Option<Res<RoadSurface>>,
+    cameras: Query<(
+        &RobotIndex,
+        &RobotId,
+        &Camera,
+        &CameraImages,
+        Option<&RoadDetector>,
+    )>,
+) {
+    let frames = frames.into_inner();
+    let now = clock.now();
+    frames.ready.clear();
+    frames.collect(Some(now - COLLECT_AFTER + 1e-9));
+    let mut fresh: Vec<_> = cameras
+        .iter()
+        .filter(|(.., images, _)| images.fresh)
+        .filter_map(|(i, id, camera, images, det)| Some((*i, id, camera, images.frame?, det)))
+        .filter(|f| frames.due(f.0, f.3.stamp))
+        .collect();
+    fresh.sort_by_key(|f| f.0);
+    let raster = surface.map_or_else(|| frames.grass.clone(), |s| s.0.clone());
+    for (robot, id, camera, frame, det) in fresh {
+        let detection = det
+            .filter(|_| frames.outputs.jpeg)
+            .and_then(|d| d.detection.clone());
+        frames.submit(Job {
+            robot,
+            name: id.0.clone(),
+            frame,
+            rays: camera.rays.clone(),
+            palette: camera.palette.clone(),
+            raster: raster.clone(),
+            detection,
+        });
+    }
+}
+
+/// Logs `frames` to the .rrd at `robots/<name>/camera` (JPEG), each at its own time; the
+/// recording's time is `now` afterwards.
+pub fn log_frames_rrd(r: &mut RrdRecorder, frames: &[RecordedFrame], now: f64) {
+    for f in frames {
+        let Some(jpeg) = &f.jpeg else { continue };
+        match jpeg {
+            Ok(bytes) => {
+                r.rec.set_duration_secs("sim_time", f.stamp);
+                let res = r.rec.log(
+                    format!("robots/{}/camera", f.name),
+                    &rerun::EncodedImage::from_file_contents(bytes.clone())
+                        .with_media_type(rerun::MediaType::JPEG),
+                );
+                r.check(res);
+            }
+            Err(e) => {
+                r.error.get_or_insert_with(|| e.clone());
+            }
+        }
+    }
+    r.rec.set_duration_secs("sim_time", now);
+}
+
+/// Record set, after [`collect_frames`]: the .rrd's camera images.
+pub fn record_frames_rrd(
+    clock: Res<SimClock>,
+    frames: Res<RecordedFrames>,
+    mut r: ResMut<RrdRecorder>,
+) {
+    if !frames.ready.is_empty() {
+        log_frames_rrd(&mut r, &frames.ready, clock.now());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use systems::body::TruePose;
+    use systems::core::{Pose2, stream_rng};
+    use systems::sensors::camera::{CameraSpec, sample_cameras};
+
+    /// Two cameras on grass, 10 Hz each, frames recorded at 2 Hz for `secs` of 50 ms ticks:
+    /// the frames handed over per tick (tick time, robot, stamp) and those left at the end.
+    fn record(secs: f64, outputs: FrameOutputs) -> (Vec<(f64, u32, f64)>, Vec<RecordedFrame>) {
+        let mut world = World::new();
+        world.insert_resource(SimClock::new(0.05));
+        world.insert_resource(RecordedFrames::new(2.0, outputs).unwrap());
+        for (i, name) in ["a", "b"].into_iter().enumerate() {
+            world.spawn((
+                RobotIndex(i as u32),
+                RobotId(name.into()),
+                TruePose::at(Pose2::new(i as f64, 0.0, 0.3)),
+                Camera::new(CameraSpec::default(), stream_rng(4, name, "camera")),
+                CameraImages::default(),
+            ));
+        }
+        let mut schedule = Schedule::default();
+        schedule.add_systems((sample_cameras, collect_frames).chain());
+        let mut handed = Vec::new();
+        for _ in 0..(secs / 0.05).round() as usize {
+            schedule.run(&mut world);
+            let now = world.resource::<SimClock>().now();
+            for f in &world.resource::<RecordedFrames>().ready {
+                handed.push((now, f.robot.0, f.stamp));
+            }
+            world.resource_mut::<SimClock>().advance();
+        }
+        let (rest, error) = world.remove_resource::<RecordedFrames>().unwrap().finish();
+        assert_eq!(error, None);
+        (handed, rest)
+    }
+
+    #[test]
+    fn frames_come_at_the_record_rate_a_second_after_they_were_taken() {
+        let outputs = FrameOutputs {
+            raw: true,
+            jpeg: false,
+        };
+        let (handed, rest) = record(3.0, outputs);
+        // ticks end at 0.05 ... 3.0 s; frames at 0, 0.5, ..., 3.0 s for each robot, robot order
+        // within a tick; handed over in the first tick at least COLLECT_AFTER later, the last
+        // second's at the end
+        let stamps: Vec<(u32, f64)> = handed.iter().map(|h| (h.1, h.2)).collect();
+        let want: Vec<(u32, f64)> = [0.0, 0.5, 1.0, 1.5, 2.0]
+            .iter()
+            .flat_map(|&t| [(0, t), (1, t)])
+            .collect();
+        assert_eq!(stamps.len(), want.len(), "{handed:?}");
+        for ((r, t), (wr, wt)) in stamps.iter().zip(&want) {
+            assert_eq!(r, wr);
+            assert!((t - wt).abs() < 1e-9, "{stamps:?}");
+        }
+        for (now, _, stamp) in &handed {
+            assert!(now - stamp >= COLLECT_AFTER - 1e-9 && now - stamp < COLLECT_AFTER + 0.05);
+        }
+        let left: Vec<(u32, f64)> = rest.iter().map(|f| (f.robot.0, f.stamp)).collect();
+        assert_eq!(left, [(0, 2.5), (1, 2.5), (0, 3.0), (1, 3.0)]);
+        assert!(rest.iter().all(|f| f.raw.is_some() && f.jpeg.is_none()));
+    }
+
+    #[test]
+    fn a_recorded_frame_is_the_cameras_image_and_its_jpeg_decodes_to_it() {
+        let outputs = FrameOutputs {
+            raw: true,
+            jpeg: true,
+        };
+        let (_, rest) = record(0.05, outputs);
+        let f = &rest[0];
+        // the same draws: a camera of the same stream takes the same frame
+        let mut cam = Camera::new(CameraSpec::default(), stream_rng(4, "a", "camera"));
+        let frame = cam.take(0.0, Pose2::new(0.0, 0.0, 0.3));
+        let want = cam.render(&frame, &SurfaceRaster::empty());
+        assert_eq!(f.raw.as_ref().unwrap(), &want);
+        let jpeg = f.jpeg.as_ref().unwrap().as_ref().unwrap();
+        let decoded = image::load_from_memory_with_format(jpeg, image::ImageFormat::Jpeg)
+            .unwrap()
+            .to_rgb8();
+        assert_eq!(decoded.dimensions(), (want.width, want.height));
+        // no road detection drawn on grass: the JPEG is the frame up to compression
+        let diff = decoded
+            .as_raw()
+            .iter()
+            .zip(&want.rgb)
+            .map(|(&a, &b)| (a as f64 - b as f64).abs())
+            .sum::<f64>()
+            / want.rgb.len() as f64;
+        assert!(diff < 8.0, "mean absolute difference {diff}");
+    }
+}
