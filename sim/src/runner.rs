@@ -411,7 +411,7 @@ fn finish_frames(w: &mut World) -> Option<String> {
     let (mut frames, error) = w.remove_resource::<RecordedFrames>()?.finish();
     let now = w.resource::<SimClock>().now();
     if let Some(mut r) = w.get_resource_mut::<RrdRecorder>() {
-        log_frames_rrd(&mut r, &frames, now);
+        log_frames_rrd(&mut r, &mut frames, now);
     }
     if let Some(mut export) = w.get_resource_mut::<McapExport>() {
         export.write_frames(&mut frames);

@@ -27,6 +27,9 @@ use systems::world::roads::{RoadSurface, SurfaceRaster};
 /// Simulated time (s) the worker has to finish a frame before the run waits for it.
 pub const COLLECT_AFTER: f64 = 1.0;
 
+/// What a run reports when the frame worker ended early.
+const WORKER_STOPPED: &str = "the camera frame worker stopped before rendering every frame";
+
 /// JPEG quality of the .rrd's frames.
 const JPEG_QUALITY: u8 = 80;
 
@@ -124,9 +127,7 @@ impl RecordedFrames {
             match done.recv() {
                 Ok(frame) => self.ready.push(frame),
                 Err(_) => {
-                    self.error.get_or_insert_with(|| {
-                        "the camera frame worker stopped before rendering every frame".into()
-                    });
+                    self.error.get_or_insert_with(|| WORKER_STOPPED.into());
                     self.in_flight.clear();
                 }
             }
@@ -151,9 +152,7 @@ impl RecordedFrames {
         if jobs.send(job).is_ok() {
             self.in_flight.push_back(stamp);
         } else {
-            self.error.get_or_insert_with(|| {
-                "the camera frame worker stopped before rendering every frame".into()
-            });
+            self.error.get_or_insert_with(|| WORKER_STOPPED.into());
         }
     }
 
@@ -185,13 +184,20 @@ fn render(job: Job, outputs: FrameOutputs) -> RecordedFrame {
         job.frame.params,
     )
     .render_here(&mut image.rgb);
-    let raw = outputs.raw.then(|| image.clone());
-    let jpeg = outputs.jpeg.then(|| {
-        if let Some(d) = &job.detection {
-            draw_detection(&mut image, d);
+    // the detection is drawn on a copy only when the raw frame is kept as well
+    let jpeg = outputs.jpeg.then(|| match &job.detection {
+        Some(d) if outputs.raw => {
+            let mut drawn = image.clone();
+            draw_detection(&mut drawn, d);
+            encode_jpeg(&drawn)
         }
-        encode_jpeg(&image)
+        Some(d) => {
+            draw_detection(&mut image, d);
+            encode_jpeg(&image)
+        }
+        None => encode_jpeg(&image),
     });
+    let raw = outputs.raw.then_some(image);
     RecordedFrame {
         robot: job.robot,
         name: job.name,
@@ -258,23 +264,23 @@ pub fn collect_frames(
     }
 }
 
-/// Logs `frames` to the .rrd at `robots/<name>/camera` (JPEG), each at its own time; the
-/// recording's time is `now` afterwards.
-pub fn log_frames_rrd(r: &mut RrdRecorder, frames: &[RecordedFrame], now: f64) {
+/// Logs `frames` to the .rrd at `robots/<name>/camera` (taking their JPEGs), each at its own
+/// time; the recording's time is `now` afterwards.
+pub fn log_frames_rrd(r: &mut RrdRecorder, frames: &mut [RecordedFrame], now: f64) {
     for f in frames {
-        let Some(jpeg) = &f.jpeg else { continue };
+        let Some(jpeg) = f.jpeg.take() else { continue };
         match jpeg {
             Ok(bytes) => {
                 r.rec.set_duration_secs("sim_time", f.stamp);
                 let res = r.rec.log(
                     format!("robots/{}/camera", f.name),
-                    &rerun::EncodedImage::from_file_contents(bytes.clone())
+                    &rerun::EncodedImage::from_file_contents(bytes)
                         .with_media_type(rerun::MediaType::JPEG),
                 );
                 r.check(res);
             }
             Err(e) => {
-                r.error.get_or_insert_with(|| e.clone());
+                r.error.get_or_insert(e);
             }
         }
     }
@@ -284,11 +290,11 @@ pub fn log_frames_rrd(r: &mut RrdRecorder, frames: &[RecordedFrame], now: f64) {
 /// Record set, after [`collect_frames`]: the .rrd's camera images.
 pub fn record_frames_rrd(
     clock: Res<SimClock>,
-    frames: Res<RecordedFrames>,
+    mut frames: ResMut<RecordedFrames>,
     mut r: ResMut<RrdRecorder>,
 ) {
     if !frames.ready.is_empty() {
-        log_frames_rrd(&mut r, &frames.ready, clock.now());
+        log_frames_rrd(&mut r, &mut frames.ready, clock.now());
     }
 }
 

@@ -194,13 +194,28 @@ impl McapRecorder {
         if sent { Ok(()) } else { Err(self.stopped()) }
     }
 
-    /// Why the writer thread is gone.
-    fn stopped(&mut self) -> anyhow::Error {
+    /// Tells the writer thread that nothing more comes and waits for it: what it returned
+    /// (the file's statistics or its first error).
+    fn hang_up(&mut self) -> anyhow::Result<McapStats> {
         self.jobs = None;
         match self.worker.take().map(JoinHandle::join) {
-            Some(Ok(Err(e))) => e,
-            Some(Err(_)) => anyhow!("{}: the MCAP writer thread panicked", self.path.display()),
-            _ => anyhow!("{}: the MCAP writer has stopped", self.path.display()),
+            Some(Ok(result)) => result,
+            Some(Err(_)) => Err(anyhow!(
+                "{}: the MCAP writer thread panicked",
+                self.path.display()
+            )),
+            None => Err(anyhow!(
+                "{}: the MCAP writer has stopped",
+                self.path.display()
+            )),
+        }
+    }
+
+    /// Why the writer thread is gone.
+    fn stopped(&mut self) -> anyhow::Error {
+        match self.hang_up() {
+            Err(e) => e,
+            Ok(_) => anyhow!("{}: the MCAP writer has stopped", self.path.display()),
         }
     }
 
@@ -296,14 +311,7 @@ impl McapRecorder {
     /// Writes the summary and the footer and closes the file.
     pub fn finish(mut self) -> anyhow::Result<McapStats> {
         self.send()?;
-        self.jobs = None;
-        match self.worker.take().map(JoinHandle::join) {
-            Some(Ok(result)) => result,
-            _ => Err(anyhow!(
-                "{}: the MCAP writer thread panicked",
-                self.path.display()
-            )),
-        }
+        self.hang_up()
     }
 
     /// Stops writing as a process that dies here would: what the writer thread had ended
@@ -312,20 +320,16 @@ impl McapRecorder {
     pub(crate) fn abandon(mut self) {
         self.batch.ops.push(Op::Abandon);
         let _ = self.send();
-        self.jobs = None;
-        if let Some(w) = self.worker.take() {
-            let _ = w.join();
-        }
+        let _ = self.hang_up();
     }
 }
 
 impl Drop for McapRecorder {
     /// Finishes the file as [`McapRecorder::finish`] does, ignoring errors.
     fn drop(&mut self) {
-        let _ = self.send();
-        self.jobs = None;
-        if let Some(w) = self.worker.take() {
-            let _ = w.join();
+        if self.worker.is_some() {
+            let _ = self.send();
+            let _ = self.hang_up();
         }
     }
 }
