@@ -2,7 +2,8 @@
 //! (Borenstein & Koren 1991): the scan is reduced to the minimum range per angular sector around
 //! the robot; a candidate heading is blocked at the nearest sector reading whose lateral offset
 //! from that heading is within the robot's half width; the behaviour then takes the free heading
-//! closest to the one it wants. O(beams + sectors × candidates) per scan.
+//! closest to the one it wants. O(beams + sectors × candidates) per scan; the points are kept as
+//! coordinate columns padded to whole lanes so the candidate test runs vectorized.
 
 use crate::core::Pose2;
 use crate::sensors::LaserScan;
@@ -10,12 +11,18 @@ use std::f64::consts::PI;
 
 pub const SECTORS: usize = 180;
 const SECTOR_WIDTH: f64 = 2.0 * PI / SECTORS as f64;
+/// Points tested side by side (the padding of the coordinate columns).
+const LANES: usize = 8;
 
 /// The nearest scan point of each 2° sector around the robot that saw something, in its base
 /// frame (a compact list: headings are tested against the points only).
 #[derive(Clone, Debug, Default)]
 pub struct SectorRanges {
-    pub points: Vec<(f32, f32)>,
+    /// x and y of the points, in sector order, padded with NaN to a multiple of [`LANES`] (a NaN
+    /// point never blocks a heading).
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    len: usize,
 }
 
 impl SectorRanges {
@@ -59,12 +66,24 @@ impl SectorRanges {
                 nearest[idx] = (px, py);
             }
         }
-        SectorRanges {
-            points: (0..SECTORS)
-                .filter(|&i| best[i].is_finite())
-                .map(|i| nearest[i])
-                .collect(),
+        let mut xs = Vec::with_capacity(SECTORS + LANES);
+        let mut ys = Vec::with_capacity(SECTORS + LANES);
+        for i in (0..SECTORS).filter(|&i| best[i].is_finite()) {
+            xs.push(nearest[i].0);
+            ys.push(nearest[i].1);
         }
+        let len = xs.len();
+        xs.resize(len.next_multiple_of(LANES), f32::NAN);
+        ys.resize(len.next_multiple_of(LANES), f32::NAN);
+        SectorRanges { xs, ys, len }
+    }
+
+    /// The seen points (base frame), in sector order.
+    pub fn points(&self) -> impl Iterator<Item = (f32, f32)> + '_ {
+        self.xs[..self.len]
+            .iter()
+            .copied()
+            .zip(self.ys[..self.len].iter().copied())
     }
 
     /// Free distance along `heading` (base frame) for a body of half width `half_width`: the
@@ -72,14 +91,19 @@ impl SectorRanges {
     pub fn free_distance(&self, heading: f64, half_width: f64) -> f64 {
         let (uy, ux) = heading.sin_cos();
         let (ux, uy, hw) = (ux as f32, uy as f32, half_width as f32);
-        let mut free = f32::INFINITY;
-        for &(x, y) in &self.points {
-            let along = x * ux + y * uy;
-            if along > 0.0 && (x * uy - y * ux).abs() < hw {
-                free = free.min(along);
+        // one running minimum per lane (the minimum of a set does not depend on the order)
+        let mut free = [f32::INFINITY; LANES];
+        for (xs, ys) in self.xs.chunks_exact(LANES).zip(self.ys.chunks_exact(LANES)) {
+            for l in 0..LANES {
+                let (x, y) = (xs[l], ys[l]);
+                let along = x * ux + y * uy;
+                // branch-free, so the lanes run as one vector operation
+                let blocks = (along > 0.0) & ((x * uy - y * ux).abs() < hw);
+                let d = if blocks { along } else { f32::INFINITY };
+                free[l] = if d < free[l] { d } else { free[l] };
             }
         }
-        free as f64
+        free.into_iter().fold(f32::INFINITY, f32::min) as f64
     }
 
     /// Among headings within ±`max_dev` of `wanted` (steps of 5°), the one closest to `wanted`

@@ -23,11 +23,11 @@ impl Navigator {
         let pts = self
             .seen
             .iter()
-            .flat_map(|s| s.points.iter())
-            .chain(self.extra.iter());
+            .flat_map(|s| s.points())
+            .chain(self.extra.iter().copied());
         if self.path.len() < 2 {
             let mut free = f64::INFINITY;
-            for &(x, y) in pts {
+            for (x, y) in pts {
                 if x > 0.0 && (y as f64).abs() < hw {
                     free = free.min(x as f64);
                 }
@@ -57,7 +57,7 @@ impl Navigator {
             Steering::Ackermann { .. } => Vec::new(),
         };
         let mut free = f64::INFINITY;
-        for &(x, y) in pts {
+        for (x, y) in pts {
             let w = pose.transform_point([x as f64, y as f64]);
             // a point on a wall the map knows (within the inscribed radius of it) is not an
             // obstacle to stop for: the plan already keeps clear of walls
@@ -131,11 +131,11 @@ impl Navigator {
     /// the whole arc would close a corridor), else the sonars'.
     pub(super) fn obstacles_world(&self, pose: &Pose2) -> Vec<[f64; 2]> {
         let mut out = Vec::new();
-        let pts: Box<dyn Iterator<Item = &(f32, f32)>> = match &self.seen {
-            Some(s) => Box::new(s.points.iter()),
-            None => Box::new(self.extra.iter()),
+        let pts: Box<dyn Iterator<Item = (f32, f32)>> = match &self.seen {
+            Some(s) => Box::new(s.points()),
+            None => Box::new(self.extra.iter().copied()),
         };
-        for &(x, y) in pts {
+        for (x, y) in pts {
             let (x, y) = (x as f64, y as f64);
             if x * x + y * y <= 16.0 {
                 out.push(pose.transform_point([x, y]));

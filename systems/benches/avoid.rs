@@ -1,0 +1,59 @@
+//! Reactive avoidance (`navigation::avoid`), what every wandering robot of `sim bench swarm` runs
+//! each tick: reducing a 180-beam scan to sector points, and choosing a heading when the way
+//! ahead is blocked (a robot 1 m from the end of a 2 m wide dead end, so most candidate headings
+//! are tested before the way back is found).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::f64::consts::PI;
+use std::hint::black_box;
+use systems::core::Pose2;
+use systems::navigation::avoid::SectorRanges;
+use systems::sensors::LaserScan;
+
+/// Range along angle `a` from the origin in a dead end: walls at x = 1 ahead and y = ±1 beside.
+fn dead_end_range(a: f64) -> f32 {
+    let (s, c) = a.sin_cos();
+    let mut r = f64::INFINITY;
+    if c > 1e-9 {
+        r = r.min(1.0 / c);
+    }
+    if s.abs() > 1e-9 {
+        r = r.min(1.0 / s.abs());
+    }
+    if r > 8.0 { f32::INFINITY } else { r as f32 }
+}
+
+fn scan() -> LaserScan {
+    let n = 180;
+    let inc = PI / (n - 1) as f64;
+    LaserScan {
+        stamp: 0.0,
+        angle_min: (-PI / 2.0) as f32,
+        angle_increment: inc as f32,
+        range_min: 0.1,
+        range_max: 8.0,
+        ranges: (0..n)
+            .map(|k| dead_end_range(-PI / 2.0 + k as f64 * inc))
+            .collect(),
+    }
+}
+
+fn bench_avoid(c: &mut Criterion) {
+    let scan = scan();
+    let mut g = c.benchmark_group("avoid_180_beams");
+    g.bench_function("from_scan", |b| {
+        b.iter(|| SectorRanges::from_scan(black_box(&scan), &Pose2::IDENTITY))
+    });
+    let sectors = SectorRanges::from_scan(&scan, &Pose2::IDENTITY);
+    g.bench_function("choose_heading_dead_end", |b| {
+        b.iter(|| sectors.choose_heading(black_box(0.0), 0.3, 1.8, PI * 0.8))
+    });
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30);
+    targets = bench_avoid
+}
+criterion_main!(benches);
