@@ -125,6 +125,11 @@ impl Physics {
         let mut pw = PhysicsWorld::new();
         pw.gravity = Vector::ZERO;
         pw.integration_parameters.dt = dt as Real;
+        // a leaf's fat-AABB skin proportional to the body (6 cm for a 0.5 m robot instead of
+        // 4 cm): a robot at 0.8 m/s moves 4 cm per 50 ms step, so with the fixed skin its leaf
+        // was re-inserted into the broad phase's tree almost every step (about 10 % less
+        // physics time with 1000 robots; the same contacts)
+        pw.broad_phase.adaptive_change_detection_margin = true;
         let (tx, ty) = world.tile_counts();
         let mut physics = Physics {
             world: pw,

@@ -68,9 +68,10 @@ fn any_beyond(fan: &Fan, out: &[f32], bmax: &[f32], lo: f32, width: f32, near: f
 }
 
 /// Occlusion test of a square region (centre offset (cx, cy) from the sensor, half diagonal
-/// `half_diag`): None if every beam that can cross it already hit something nearer, otherwise
-/// the distance from the sensor to its nearest possible point. The sensor's own neighbourhood is
-/// always visible.
+/// `half_diag`): false if its nearest possible point lies beyond `horizon` (the longest range
+/// any beam still has) or if every beam that can cross it already hit something nearer. The
+/// sensor's own neighbourhood is always visible.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 fn visible(
     fan: &Fan,
@@ -80,16 +81,20 @@ fn visible(
     cy: f32,
     half_diag: f32,
     inc: f32,
-) -> Option<f32> {
+    horizon: f32,
+) -> bool {
     let dist = (cx * cx + cy * cy).sqrt();
     let near = dist - half_diag;
+    if near > horizon {
+        return false;
+    }
     if dist <= half_diag * 1.05 {
-        return Some(near);
+        return true;
     }
     // asin(x) ≤ x·π/2 on [0, 1]: a slightly wide, never narrow, interval
     let half = (half_diag / dist).min(1.0) * std::f32::consts::FRAC_PI_2 + inc;
     let lo = fast_atan2(cy, cx) - half;
-    any_beyond(fan, out, bmax, lo, 2.0 * half, near).then_some(near)
+    any_beyond(fan, out, bmax, lo, 2.0 * half, near)
 }
 
 /// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`.
@@ -333,9 +338,8 @@ impl Faces {
             if behind(cx, cy, super_half_diag) {
                 continue;
             }
-            match visible(&fan, out, bmax, cx, cy, super_half_diag, inc) {
-                Some(near) if near <= max_range => {}
-                _ => continue,
+            if !visible(&fan, out, bmax, cx, cy, super_half_diag, inc, horizon) {
+                continue;
             }
             // its tiles, nearest corner first (the order only makes occlusion more effective)
             let (x0, y0) = (sx as usize * SUPER, sy as usize * SUPER);
@@ -366,9 +370,8 @@ impl Faces {
                     if behind(tcx, tcy, half_diag) {
                         continue;
                     }
-                    match visible(&fan, out, bmax, tcx, tcy, half_diag, inc) {
-                        Some(near) if near <= max_range => {}
-                        _ => continue,
+                    if !visible(&fan, out, bmax, tcx, tcy, half_diag, inc, horizon) {
+                        continue;
                     }
                     let (mut k0, mut k1) = (usize::MAX, 0);
                     for f in faces {
