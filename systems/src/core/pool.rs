@@ -71,8 +71,13 @@ impl KernelPool {
                 while section.load(Ordering::Acquire) == this {
                     std::hint::spin_loop();
                     spins = spins.wrapping_add(1);
-                    if spins.is_multiple_of(256) && since.elapsed() > STAY_AWAKE {
-                        break;
+                    if spins.is_multiple_of(256) {
+                        if since.elapsed() > STAY_AWAKE {
+                            break;
+                        }
+                        // a thread of another run waiting for this core gets it (batch runs
+                        // with several threads each); the core itself stays awake
+                        std::thread::yield_now();
                     }
                 }
             });
