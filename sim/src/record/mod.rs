@@ -7,6 +7,7 @@ pub mod frames;
 pub mod mcap;
 pub mod navigation;
 pub mod outdoor;
+pub mod path_trace;
 pub mod replay;
 pub mod rrd;
 pub mod slam;

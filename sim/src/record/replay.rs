@@ -5,7 +5,8 @@
 //! odometry frame for a log of `sim run --carmen-out`). The `sim_time` timeline counts seconds
 //! from the log's first record.
 
-use super::rrd::{close_recording, open_recording, push_point};
+use super::path_trace::PathTrace;
+use super::rrd::{close_recording, open_recording};
 use super::slam::{SlamTrack, log_slam_scan, log_slam_state, slam_entity};
 use super::stream::RrdStream;
 use std::path::Path;
@@ -24,8 +25,8 @@ pub struct ReplayRecorder {
     t0: f64,
     track: SlamTrack,
     scan_at: Option<f64>,
-    odometry: Vec<[f32; 3]>,
-    truth: Vec<[f32; 3]>,
+    odometry: PathTrace,
+    truth: PathTrace,
     error: Option<String>,
 }
 
@@ -45,8 +46,8 @@ impl ReplayRecorder {
             t0,
             track: SlamTrack::new(slam_rate),
             scan_at: None,
-            odometry: Vec::new(),
-            truth: Vec::new(),
+            odometry: PathTrace::default(),
+            truth: PathTrace::default(),
             error: None,
         })
     }
@@ -66,9 +67,9 @@ impl ReplayRecorder {
         (stamp, odom, truth, mount): (f64, &Pose2, Option<Pose2>, &Pose2),
     ) {
         let t = stamp - self.t0;
-        push_point(&mut self.odometry, odom);
+        self.odometry.push(odom);
         if let Some(p) = truth {
-            push_point(&mut self.truth, &p);
+            self.truth.push(&p);
         }
         self.rec.set_duration_secs("sim_time", t);
         if self.scan_at.is_none_or(|a| t - a >= 1.0 / SCAN_RATE - 1e-9)
@@ -91,8 +92,9 @@ impl ReplayRecorder {
             ("odometry", &self.odometry, grey),
             ("truth", &self.truth, rerun::Color::from_rgb(31, 119, 180)),
         ] {
-            if path.len() >= 2 {
-                let strip = rerun::LineStrips3D::new([path.clone()]).with_colors([colour]);
+            let strip = path.strip();
+            if strip.len() >= 2 {
+                let strip = rerun::LineStrips3D::new([strip]).with_colors([colour]);
                 let res = self
                     .rec
                     .log(format!("robots/{}/{leaf}", self.robot), &strip);

@@ -28,6 +28,7 @@
 //! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
 
 use super::belief::{self, Cloud};
+use super::path_trace::PathTrace;
 use super::stream::RrdStream;
 use crate::scenario::RecordConfig;
 use bevy_ecs::prelude::*;
@@ -41,8 +42,6 @@ use systems::localization::{Localizer, Localizers, PoseEstimate, WheelOdometry};
 use systems::sensors::{LaserScans, LaserTruth, SonarReadings, SonarTruth, Sonars};
 use systems::world::{Cell, OccupancyGrid};
 
-/// Minimum spacing of recorded path points (m).
-const PATH_SPACING: f64 = 0.05;
 /// Points kept in a person's trail (at the pose rate: 3 s at the default 10 Hz).
 const TRAIL_POINTS: usize = 30;
 
@@ -52,8 +51,8 @@ pub struct RrdRecorder {
     pose_timer: RateTimer,
     scan_timer: RateTimer,
     path_timer: RateTimer,
-    truth_paths: Vec<Vec<[f32; 3]>>,
-    odom_paths: Vec<Vec<[f32; 3]>>,
+    truth_paths: Vec<PathTrace>,
+    odom_paths: Vec<PathTrace>,
     /// Per person (by index): the last poses logged.
     trails: Vec<VecDeque<[f32; 3]>>,
     /// Per robot (by index), per localizer (in the robot's order).
@@ -68,7 +67,7 @@ pub struct RrdRecorder {
 /// What the recorder keeps per localizer.
 #[derive(Default)]
 struct Track {
-    path: Vec<[f32; 3]>,
+    path: PathTrace,
     /// Simulated time of the last logged particle set.
     particles_at: Option<f64>,
     /// Whether the series styles were logged.
@@ -88,15 +87,6 @@ pub(super) fn colour(index: u32) -> rerun::Color {
     ];
     let c = PALETTE[index as usize % PALETTE.len()];
     rerun::Color::from_rgb(c[0], c[1], c[2])
-}
-
-pub(super) fn push_point(path: &mut Vec<[f32; 3]>, p: &Pose2) {
-    let q = [p.x as f32, p.y as f32, 0.0];
-    match path.last() {
-        Some(l) if ((l[0] - q[0]).powi(2) + (l[1] - q[1]).powi(2)).sqrt() < PATH_SPACING as f32 => {
-        }
-        _ => path.push(q),
-    }
 }
 
 impl RrdRecorder {
@@ -333,7 +323,7 @@ impl RrdRecorder {
             }
         }
         for e in &l.fresh {
-            push_point(&mut self.tracks[robot][k].path, &e.estimate.pose);
+            self.tracks[robot][k].path.push(&e.estimate.pose);
         }
         if let Some(e) = l.fresh.last() {
             self.rec.set_duration_secs("sim_time", e.stamp);
@@ -356,7 +346,7 @@ impl RrdRecorder {
         self.rec.set_duration_secs("sim_time", now);
         if paths_due && !self.tracks[robot][k].path.is_empty() {
             let strip =
-                rerun::LineStrips3D::new([self.tracks[robot][k].path.clone()]).with_colors([c]);
+                rerun::LineStrips3D::new([self.tracks[robot][k].path.strip()]).with_colors([c]);
             let res = self.rec.log(est_path.as_str(), &strip);
             self.check(res);
         }
@@ -426,8 +416,8 @@ pub fn record_rrd(
     for (idx, id, truth, footprint, odom, laser, locs, sonar) in sorted {
         let i = idx.0 as usize;
         if r.truth_paths.len() <= i {
-            r.truth_paths.resize_with(i + 1, Vec::new);
-            r.odom_paths.resize_with(i + 1, Vec::new);
+            r.truth_paths.resize_with(i + 1, PathTrace::default);
+            r.odom_paths.resize_with(i + 1, PathTrace::default);
         }
         let base = format!("robots/{}", id.0);
         if let Some((locs, samples)) = locs {
@@ -443,9 +433,9 @@ pub fn record_rrd(
         if !(poses_due || scans_due || paths_due) {
             continue;
         }
-        push_point(&mut r.truth_paths[i], &truth.pose);
+        r.truth_paths[i].push(&truth.pose);
         if let Some(o) = odom {
-            push_point(&mut r.odom_paths[i], &o.pose);
+            r.odom_paths[i].push(&o.pose);
         }
         let c = colour(idx.0);
         if poses_due {
@@ -473,11 +463,11 @@ pub fn record_rrd(
             }
         }
         if paths_due {
-            let strip = rerun::LineStrips3D::new([r.truth_paths[i].clone()]).with_colors([c]);
+            let strip = rerun::LineStrips3D::new([r.truth_paths[i].strip()]).with_colors([c]);
             let res = r.rec.log(format!("{base}/truth"), &strip);
             r.check(res);
             if odom.is_some() {
-                let strip = rerun::LineStrips3D::new([r.odom_paths[i].clone()])
+                let strip = rerun::LineStrips3D::new([r.odom_paths[i].strip()])
                     .with_colors([rerun::Color::from_rgb(150, 150, 150)]);
                 let res = r.rec.log(format!("{base}/odometry"), &strip);
                 r.check(res);
