@@ -25,6 +25,8 @@ pub struct KernelPool {
     /// Bumped at the start and end of every parallel section; a waiting worker stops as soon as
     /// it changes (the next section needs it) or after [`STAY_AWAKE`].
     section: Arc<AtomicU64>,
+    /// Waiting jobs queued so far.
+    queued: Arc<AtomicU64>,
 }
 
 impl KernelPool {
@@ -40,6 +42,7 @@ impl KernelPool {
             pool: Arc::new(pool),
             awake,
             section: Arc::new(AtomicU64::new(0)),
+            queued: Arc::new(AtomicU64::new(0)),
         })
     }
 
@@ -58,11 +61,14 @@ impl KernelPool {
     }
 
     /// Queues `awake` jobs that spin until the next section starts or [`STAY_AWAKE`] passes.
+    /// Not from inside the pool (a nested `install`): a waiting job queued there would hold a
+    /// worker that the enclosing section still needs.
     fn stay_awake(&self) {
-        if self.awake == 0 {
+        if self.awake == 0 || self.pool.current_thread_index().is_some() {
             return;
         }
         let this = self.section.fetch_add(1, Ordering::AcqRel) + 1;
+        self.queued.fetch_add(self.awake as u64, Ordering::Relaxed);
         for _ in 0..self.awake {
             let section = self.section.clone();
             self.pool.spawn(move || {
@@ -137,6 +143,26 @@ mod tests {
         assert!(
             two.iter().all(|t| *t != Some(caller)),
             "several items go to the pool"
+        );
+    }
+
+    #[test]
+    fn only_sections_started_outside_the_pool_leave_workers_waiting() {
+        // an install inside an install must not queue waiting jobs on the pool's own workers
+        // (the enclosing section still needs them); a top-level one queues one per core but one
+        let pool = KernelPool::new(2).unwrap();
+        let queued = || pool.queued.load(Ordering::Relaxed);
+        pool.install(|| {
+            pool.install(|| ());
+            assert_eq!(queued(), 0, "a nested section queued waiting jobs");
+        });
+        assert_eq!(queued(), pool.awake as u64);
+        let one = KernelPool::new(1).unwrap();
+        one.install(|| ());
+        assert_eq!(
+            one.queued.load(Ordering::Relaxed),
+            0,
+            "one worker never waits"
         );
     }
 
