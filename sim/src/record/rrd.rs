@@ -475,7 +475,7 @@ pub fn record_rrd(
         }
         if scans_due
             && let Some((scans, lt)) = laser
-            && let (Some(scan), Some(pose)) = (&scans.latest, &lt.latest)
+            && let (Some(scan), Some(pose)) = (scans.latest(), &lt.latest)
         {
             let res = r
                 .rec

@@ -256,7 +256,7 @@ fn record(
             }
             if scans_due
                 && let Some((scans, laser)) = laser
-                && let (Some(scan), Some(e)) = (&scans.latest, est.estimate())
+                && let (Some(scan), Some(e)) = (scans.latest(), est.estimate())
             {
                 let res =
                     log_slam_scan(&mut r.rec, &base, scan, &e.pose.compose(&laser.spec.mount));

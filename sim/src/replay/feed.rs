@@ -80,7 +80,7 @@ pub fn feed_recorded(clock: Res<SimClock>, feed: ResMut<ReplayFeed>, mut robots:
         truth.prev = truth.pose;
         truth.pose = now;
         if let Some((laser, mut scans, mut laser_truth)) = laser {
-            scans.scans.clear();
+            scans.next_tick();
             laser_truth.poses.clear();
             for s in due(&f.scans, scan_i, end, |s| s.stamp) {
                 let at = ((s.stamp - start) / dt).clamp(0.0, 1.0);
@@ -89,8 +89,7 @@ pub fn feed_recorded(clock: Res<SimClock>, feed: ResMut<ReplayFeed>, mut robots:
                     .push(truth.interpolate(at).compose(&laser.spec.mount));
                 scans.scans.push(s.clone());
             }
-            if let Some(last) = scans.scans.last() {
-                scans.latest = Some(last.clone());
+            if !scans.scans.is_empty() {
                 laser_truth.latest = laser_truth.poses.last().copied();
             }
         }

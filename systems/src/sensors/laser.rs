@@ -129,11 +129,28 @@ impl Laser {
     }
 }
 
-/// Readings: the scans of the current tick (estimators consume these) and the latest one.
+/// Readings: the scans of the current tick (estimators consume these) and, through
+/// [`LaserScans::latest`], the latest one.
 #[derive(Component, Clone, Debug, Default)]
 pub struct LaserScans {
     pub scans: Vec<LaserScan>,
-    pub latest: Option<LaserScan>,
+    /// The last scan of an earlier tick (kept by moving, not copying, at [`LaserScans::next_tick`]).
+    previous: Option<LaserScan>,
+}
+
+impl LaserScans {
+    /// The latest scan: this tick's last, else the last of an earlier tick.
+    pub fn latest(&self) -> Option<&LaserScan> {
+        self.scans.last().or(self.previous.as_ref())
+    }
+
+    /// Starts a tick: this tick's scans are dropped, except the last, which stays the latest.
+    pub fn next_tick(&mut self) {
+        if let Some(last) = self.scans.pop() {
+            self.previous = Some(last);
+        }
+        self.scans.clear();
+    }
 }
 
 /// The true sensor pose of each scan of this tick (for evaluation and recording only).
@@ -201,7 +218,7 @@ pub fn sample_lasers(
         &mut jobs,
         Scratch::default,
         |s, (index, truth, laser, scans, laser_truth)| {
-            scans.scans.clear();
+            scans.next_tick();
             laser_truth.poses.clear();
             let laser = &mut **laser;
             laser.timer.due(start, end, &mut s.due);
@@ -238,8 +255,7 @@ pub fn sample_lasers(
                 });
                 laser_truth.poses.push(sensor);
             }
-            if let Some(last) = scans.scans.last() {
-                scans.latest = Some(last.clone());
+            if !scans.scans.is_empty() {
                 laser_truth.latest = laser_truth.poses.last().copied();
             }
         },
@@ -250,6 +266,29 @@ pub fn sample_lasers(
 mod tests {
     use super::*;
     use crate::core::stream_rng;
+
+    #[test]
+    fn the_latest_scan_outlives_its_tick_until_a_newer_one() {
+        let scan = |stamp: f64| LaserScan {
+            stamp,
+            angle_min: 0.0,
+            angle_increment: 0.1,
+            range_min: 0.1,
+            range_max: 10.0,
+            ranges: vec![1.0; 3],
+        };
+        let mut s = LaserScans::default();
+        assert!(s.latest().is_none());
+        s.scans.extend([scan(0.1), scan(0.2)]);
+        assert_eq!(s.latest().map(|l| l.stamp), Some(0.2));
+        s.next_tick();
+        assert!(s.scans.is_empty(), "a new tick starts without scans");
+        assert_eq!(s.latest().map(|l| l.stamp), Some(0.2));
+        s.next_tick();
+        assert_eq!(s.latest().map(|l| l.stamp), Some(0.2));
+        s.scans.push(scan(0.5));
+        assert_eq!(s.latest().map(|l| l.stamp), Some(0.5));
+    }
 
     #[test]
     fn presets_have_the_datasheet_beam_counts() {

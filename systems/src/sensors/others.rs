@@ -187,7 +187,7 @@ mod tests {
         schedule.add_systems((update_robot_outlines, sample_lasers).chain());
         schedule.run(&mut world);
         let scans = world.get::<LaserScans>(robot).expect("scans");
-        let scan = scans.latest.as_ref().expect("a scan");
+        let scan = scans.latest().expect("a scan");
         let mid = spec.beams() / 2;
         assert!(
             (scan.ranges[mid] - 2.75).abs() < 1e-3,
