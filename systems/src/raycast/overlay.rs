@@ -1,9 +1,37 @@
 //! Moving obstacles (other robots) drawn into an already-cast scan: each obstacle maps to the
 //! beam-index interval it subtends from the sensor, and only those beams are intersected, so the
-//! cost is proportional to the beams actually covered.
+//! cost is proportional to the beams actually covered. Beam directions inside an interval are
+//! rotated on from its first beam (two multiply-adds per beam instead of a sine and a cosine).
 
 use super::fan::Fan;
 use std::f32::consts::{PI, TAU};
+
+/// Calls `f(k, (cos, sin))` with the direction of every beam `start + k·increment` in the arc
+/// [lo, lo + width]. Each run of beams starts from an exact `sin_cos` and rotates by the
+/// increment (re-anchored every 32 beams, so rounding stays far below a micrometre at 20 m).
+#[inline]
+fn for_each_beam(
+    fan: &Fan,
+    start: f32,
+    increment: f32,
+    lo: f32,
+    width: f32,
+    mut f: impl FnMut(usize, f32, f32),
+) {
+    let (si, ci) = increment.sin_cos();
+    for (k0, k1) in fan.ranges(lo, width).into_iter().flatten() {
+        let (mut sy, mut sx) = (0.0f32, 1.0f32);
+        for k in k0..=k1 {
+            if (k - k0) % 32 == 0 {
+                (sy, sx) = (start + k as f32 * increment).sin_cos();
+            }
+            f(k, sx, sy);
+            let nx = sx * ci - sy * si;
+            sy = sx * si + sy * ci;
+            sx = nx;
+        }
+    }
+}
 
 /// Circles (cx, cy, radius): out[k] = min(out[k], distance to the circle along beam k). A sensor
 /// inside a circle sees 0 on every beam.
@@ -26,17 +54,23 @@ pub fn overlay_circles(
         let half = (r / d).asin();
         let centre = vy.atan2(vx);
         let c = d2 - r * r;
-        fan.for_each_in(centre - half, 2.0 * half, |k| {
-            let (sy, sx) = (start + k as f32 * increment).sin_cos();
-            let b = sx * vx + sy * vy;
-            let disc = b * b - c;
-            if disc >= 0.0 {
-                let t = b - disc.sqrt();
-                if t >= 0.0 && t < out[k] {
-                    out[k] = t;
+        for_each_beam(
+            &fan,
+            start,
+            increment,
+            centre - half,
+            2.0 * half,
+            |k, sx, sy| {
+                let b = sx * vx + sy * vy;
+                let disc = b * b - c;
+                if disc >= 0.0 {
+                    let t = b - disc.sqrt();
+                    if t >= 0.0 && t < out[k] {
+                        out[k] = t;
+                    }
                 }
-            }
-        });
+            },
+        );
     }
 }
 
@@ -62,18 +96,24 @@ pub fn overlay_segments(
         }
         let (lo, width) = if diff >= 0.0 { (a0, diff) } else { (a1, -diff) };
         let (ex, ey) = (bx - ax, by - ay);
-        fan.for_each_in(lo - 1e-6, width + 2e-6, |k| {
-            let (sy, sx) = (start + k as f32 * increment).sin_cos();
-            // solve t·s = a + u·e for t ≥ 0, u ∈ [0, 1]
-            let den = sx * ey - sy * ex;
-            if den.abs() < 1e-12 {
-                return;
-            }
-            let t = (ax * ey - ay * ex) / den;
-            let u = (ax * sy - ay * sx) / den;
-            if t >= 0.0 && (-1e-6..=1.0 + 1e-6).contains(&u) && t < out[k] {
-                out[k] = t;
-            }
-        });
+        for_each_beam(
+            &fan,
+            start,
+            increment,
+            lo - 1e-6,
+            width + 2e-6,
+            |k, sx, sy| {
+                // solve t·s = a + u·e for t ≥ 0, u ∈ [0, 1]
+                let den = sx * ey - sy * ex;
+                if den.abs() < 1e-12 {
+                    return;
+                }
+                let t = (ax * ey - ay * ex) / den;
+                let u = (ax * sy - ay * sx) / den;
+                if t >= 0.0 && (-1e-6..=1.0 + 1e-6).contains(&u) && t < out[k] {
+                    out[k] = t;
+                }
+            },
+        );
     }
 }
