@@ -1,5 +1,6 @@
 //! Ray-casting kernels on the hospital map (and tiled 4 × 4): random single rays and whole scans
-//! from random free poses, 20 m rays, against the plain DDA baseline. Throughput is rays/s.
+//! from random free poses, 20 m rays, against the plain DDA baseline; scans also ray by ray
+//! (`raymap_rays`: the distance-field walk the sweep replaces). Throughput is rays/s.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::RngExt;
@@ -109,6 +110,15 @@ fn bench(c: &mut Criterion) {
                     for &(p, a) in &s.poses[..n_scans] {
                         s.map
                             .cast_scan(p, a - fov.to_radians() / 2.0, inc, range, &mut out);
+                    }
+                    black_box(out[beams / 2])
+                })
+            });
+            g.bench_function(BenchmarkId::new("raymap_rays", s.name), |b| {
+                b.iter(|| {
+                    for &(p, a) in &s.poses[..n_scans] {
+                        s.map
+                            .cast_scan_rays(p, a - fov.to_radians() / 2.0, inc, range, &mut out);
                     }
                     black_box(out[beams / 2])
                 })
