@@ -9,6 +9,7 @@ pub mod navigation;
 pub mod outdoor;
 pub mod path_trace;
 pub mod replay;
+pub mod rows;
 pub mod rrd;
 pub mod slam;
 pub mod stream;

@@ -17,8 +17,10 @@
 //!
 //! The camera images (`robots/<name>/camera`) come from [`super::frames`].
 
+use super::rows;
 use super::rrd::RrdRecorder;
 use bevy_ecs::prelude::*;
+use rerun::components::{Position3D, Radius};
 use systems::body::TruePose;
 use systems::core::{RobotId, RobotIndex, SimClock};
 use systems::localization::road_wiring::RoadLocalization;
@@ -34,6 +36,41 @@ struct Logged {
     route_start: Option<usize>,
     particles_at: f64,
     poses_at: f64,
+    /// Its entity paths, made at its first row.
+    paths: Option<Paths>,
+}
+
+/// A robot's entity paths (made once: a run logs thousands of rows to them).
+#[derive(Clone)]
+struct Paths {
+    gps: String,
+    gps_error: String,
+    path: String,
+    task: String,
+    /// Per road localizer (in the robot's order): estimate, error and particles.
+    slots: Vec<[String; 3]>,
+}
+
+impl Paths {
+    fn new(robot: &str, slots: &[String]) -> Self {
+        let base = format!("robots/{robot}");
+        Paths {
+            gps: format!("{base}/gps"),
+            gps_error: format!("{base}/error/gps"),
+            path: format!("{base}/path"),
+            task: format!("{base}/task"),
+            slots: slots
+                .iter()
+                .map(|name| {
+                    [
+                        format!("{base}/estimate/{name}"),
+                        format!("{base}/error/{name}"),
+                        format!("{base}/particles/{name}"),
+                    ]
+                })
+                .collect(),
+        }
+    }
 }
 
 #[derive(Resource)]
@@ -177,29 +214,36 @@ pub fn record_outdoor(
         }
         let (pose_period, particle_period) = (state.pose_period, state.particle_period);
         let logged = &mut state.robots[i];
-        let base = format!("robots/{}", id.0);
+        let paths = logged.paths.get_or_insert_with(|| {
+            let names: Vec<String> = loc
+                .map(|l| l.slots.iter().map(|s| s.name.to_string()).collect())
+                .unwrap_or_default();
+            Paths::new(&id.0, &names)
+        });
         r.rec.set_duration_secs("sim_time", now);
         let p = [truth.pose.x, truth.pose.y];
         if let Some(loc) = loc {
             for &(t, xy) in &loc.fixes {
                 r.rec.set_duration_secs("sim_time", t);
-                let res = r.rec.log(
-                    format!("{base}/gps"),
-                    &rerun::Points3D::new([[xy[0] as f32, xy[1] as f32, 0.05]])
-                        .with_radii([0.3])
-                        .with_colors([rerun::Color::from_rgb(255, 200, 0)]),
+                rows::points(
+                    &mut r.rec,
+                    &paths.gps,
+                    [[xy[0] as f32, xy[1] as f32, 0.05]],
+                    0.3,
+                )
+                .with(
+                    rerun::Points3D::descriptor_colors(),
+                    [rerun::Color::from_rgb(255, 200, 0)],
                 );
-                r.check(res);
                 let err = (xy[0] - p[0]).hypot(xy[1] - p[1]);
-                let res = r
-                    .rec
-                    .log(format!("{base}/error/gps"), &rerun::Scalars::single(err));
-                r.check(res);
+                rows::scalar(&mut r.rec, &paths.gps_error, err);
             }
             r.rec.set_duration_secs("sim_time", now);
             let pose_due = now >= logged.poses_at + pose_period - 1e-9;
             let particles_due = now >= logged.particles_at + particle_period - 1e-9;
-            for (k, s) in loc.slots.iter().enumerate() {
+            for (k, (s, [estimate, error, particles])) in
+                loc.slots.iter().zip(&paths.slots).enumerate()
+            {
                 if let Some(e) = s.estimate.filter(|_| pose_due) {
                     let label = format!(
                         "{} {}→{} ({:.0} %)",
@@ -209,38 +253,35 @@ pub fn record_outdoor(
                         g.nodes[e.toward].source,
                         100.0 * e.confidence
                     );
-                    let res = r.rec.log(
-                        format!("{base}/estimate/{}", s.name),
-                        &rerun::Points3D::new([[e.xy[0] as f32, e.xy[1] as f32, 0.1]])
-                            .with_radii([0.5])
-                            .with_colors([super::rrd::colour(k as u32 + 2)])
-                            .with_labels([label]),
-                    );
-                    r.check(res);
+                    let at = [e.xy[0] as f32, e.xy[1] as f32, 0.1];
+                    rows::points(&mut r.rec, estimate, [at], 0.5)
+                        .with(
+                            rerun::Points3D::descriptor_colors(),
+                            [super::rrd::colour(k as u32 + 2)],
+                        )
+                        .with(
+                            rerun::Points3D::descriptor_labels(),
+                            [rerun::components::Text::from(label)],
+                        );
                     let err = (e.xy[0] - p[0]).hypot(e.xy[1] - p[1]);
-                    let res = r.rec.log(
-                        format!("{base}/error/{}", s.name),
-                        &rerun::Scalars::single(err),
-                    );
-                    r.check(res);
+                    rows::scalar(&mut r.rec, error, err);
                 }
                 if particles_due {
                     let cells = s.filter.belief_cells(g);
                     let max = cells.iter().map(|c| c.3).fold(0.0, f64::max).max(1e-12);
-                    let pts: Vec<[f32; 3]> = cells
+                    let pts = cells.iter().map(|&(e, _, along, _)| {
+                        let q = g.point_on(e, along);
+                        Position3D::from([q[0] as f32, q[1] as f32, 0.08])
+                    });
+                    let radii = cells
                         .iter()
-                        .map(|&(e, _, along, _)| {
-                            let q = g.point_on(e, along);
-                            [q[0] as f32, q[1] as f32, 0.08]
-                        })
-                        .collect();
-                    let res = r.rec.log(
-                        format!("{base}/particles/{}", s.name),
-                        &rerun::Points3D::new(pts)
-                            .with_radii(cells.iter().map(|c| 0.15 + 0.6 * (c.3 / max) as f32))
-                            .with_colors(cells.iter().map(|c| ramp((c.3 / max) as f32))),
-                    );
-                    r.check(res);
+                        .map(|c| Radius::new_scene_units(0.15 + 0.6 * (c.3 / max) as f32));
+                    let colors = cells.iter().map(|c| ramp((c.3 / max) as f32));
+                    r.rec
+                        .row(particles)
+                        .with(rerun::Points3D::descriptor_positions(), pts)
+                        .with(rerun::Points3D::descriptor_radii(), radii)
+                        .with(rerun::Points3D::descriptor_colors(), colors);
                 }
             }
             if pose_due {
@@ -264,7 +305,7 @@ pub fn record_outdoor(
                         .map(|n| [g.nodes[n].pos[0] as f32, g.nodes[n].pos[1] as f32, 0.03])
                         .collect();
                     let res = r.rec.log(
-                        format!("{base}/path"),
+                        &paths.path,
                         &rerun::LineStrips3D::new([pts])
                             .with_radii([0.25])
                             .with_colors([rerun::Color::from_rgb(40, 200, 80)]),
@@ -280,7 +321,7 @@ pub fn record_outdoor(
                     rerun::TextLogLevel::INFO
                 };
                 let res = r.rec.log(
-                    format!("{base}/task"),
+                    &paths.task,
                     &rerun::TextLog::new(text.as_str()).with_level(level),
                 );
                 r.check(res);

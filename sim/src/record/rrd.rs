@@ -29,6 +29,7 @@
 
 use super::belief::{self, Cloud};
 use super::path_trace::PathTrace;
+use super::rows;
 use super::stream::RrdStream;
 use crate::scenario::RecordConfig;
 use bevy_ecs::prelude::*;
@@ -166,16 +167,20 @@ pub(super) fn scan_cloud(
     sensor: &Pose2,
     c: rerun::Color,
 ) -> rerun::Points3D {
-    let pts: Vec<[f32; 3]> = scan
-        .points()
-        .map(|p| {
-            let w = sensor.transform_point([p[0] as f64, p[1] as f64]);
-            [w[0] as f32, w[1] as f32, 0.0]
-        })
-        .collect();
-    rerun::Points3D::new(pts)
+    rerun::Points3D::new(scan_points(scan, sensor))
         .with_radii([0.03])
         .with_colors([c])
+}
+
+/// A scan's end points in the frame drawn (`sensor`: the laser's pose in it).
+fn scan_points<'a>(
+    scan: &'a systems::sensors::LaserScan,
+    sensor: &'a Pose2,
+) -> impl Iterator<Item = [f32; 3]> + 'a {
+    scan.points().map(|p| {
+        let w = sensor.transform_point([p[0] as f64, p[1] as f64]);
+        [w[0] as f32, w[1] as f32, 0.0]
+    })
 }
 
 /// Opens an .rrd file for writing, z up (the floor plan seen from above).
@@ -219,29 +224,22 @@ pub(super) fn grid_map(
     .with_colormap(colormap)
 }
 
-fn arrow(p: &Pose2, len: f32, c: rerun::Color) -> rerun::Arrows3D {
-    rerun::Arrows3D::from_vectors([[len * p.theta.cos() as f32, len * p.theta.sin() as f32, 0.0]])
-        .with_origins([[p.x as f32, p.y as f32, 0.0]])
-        .with_colors([c])
-}
-
-fn cloud(c: &Cloud) -> rerun::Points3D {
-    rerun::Points3D::new(c.points.iter().copied())
-        .with_colors(
-            c.colors
-                .iter()
-                .map(|k| rerun::Color::from_rgb(k[0], k[1], k[2])),
-        )
-        .with_radii([c.radius])
+/// A particle set's row.
+fn log_cloud(rec: &mut RrdStream, path: &str, c: &Cloud) {
+    rows::points(rec, path, c.points.iter().copied(), c.radius).with(
+        rerun::Points3D::descriptor_colors(),
+        c.colors
+            .iter()
+            .map(|k| rerun::Color::from_rgb(k[0], k[1], k[2])),
+    );
 }
 
 /// The finite sonar readings in the world frame, from the true base pose at their firing: per
 /// sonar, the sensor → an arc across its cone at the measured range → the sensor.
-fn sonar_echoes(s: &Sonars, ranges: &[f32], base: &Pose2, c: rerun::Color) -> rerun::LineStrips3D {
+fn sonar_echoes(s: &Sonars, ranges: &[f32], base: &Pose2) -> Vec<Vec<[f32; 3]>> {
     const ARC: usize = 8;
     let cone = s.spec.cone;
-    let strips: Vec<Vec<[f32; 3]>> = s
-        .mounts
+    s.mounts
         .iter()
         .zip(ranges)
         .filter(|(_, r)| r.is_finite())
@@ -255,8 +253,7 @@ fn sonar_echoes(s: &Sonars, ranges: &[f32], base: &Pose2, c: rerun::Color) -> re
             });
             std::iter::once(o).chain(arc).chain([o]).collect()
         })
-        .collect();
-    rerun::LineStrips3D::new(strips).with_colors([c])
+        .collect()
 }
 
 /// Colour of a robot's `k`-th localizer (its estimate arrow, path and covariance).
@@ -286,6 +283,7 @@ impl RrdRecorder {
         let c = localizer_colour(k);
         let est_path = format!("{base}/estimate/{name}");
         let err_path = format!("{base}/error/{name}");
+        let heading_path = format!("{err_path}/heading");
         if !self.tracks[robot][k].styled {
             self.tracks[robot][k].styled = true;
             let res = self.rec.log_static(
@@ -296,7 +294,7 @@ impl RrdRecorder {
             );
             self.check(res);
             let res = self.rec.log_static(
-                format!("{err_path}/heading"),
+                heading_path.as_str(),
                 &rerun::SeriesLines::new()
                     .with_names([format!("{name} heading error (rad)")])
                     .with_colors([c]),
@@ -310,16 +308,9 @@ impl RrdRecorder {
         if paired {
             for s in &samples[samples.len() - fresh..] {
                 self.rec.set_duration_secs("sim_time", s.t);
-                let res = self.rec.log(
-                    err_path.as_str(),
-                    &rerun::Scalars::single(s.position_error()),
-                );
-                self.check(res);
+                rows::scalar(&mut self.rec, &err_path, s.position_error());
                 let dth = wrap_angle(s.estimate.theta - s.truth.theta).abs();
-                let res = self
-                    .rec
-                    .log(format!("{err_path}/heading"), &rerun::Scalars::single(dth));
-                self.check(res);
+                rows::scalar(&mut self.rec, &heading_path, dth);
             }
         }
         for e in &l.fresh {
@@ -337,24 +328,18 @@ impl RrdRecorder {
                 && let Some(set) = belief::filter_cloud(&l.filter, self.particle_points)
             {
                 self.tracks[robot][k].particles_at = Some(e.stamp);
-                let res = self
-                    .rec
-                    .log(format!("{base}/particles/{name}"), &cloud(&set));
-                self.check(res);
+                log_cloud(&mut self.rec, &format!("{base}/particles/{name}"), &set);
             }
         }
         self.rec.set_duration_secs("sim_time", now);
         if paths_due && !self.tracks[robot][k].path.is_empty() {
-            let strip =
-                rerun::LineStrips3D::new([self.tracks[robot][k].path.strip()]).with_colors([c]);
-            let res = self.rec.log(est_path.as_str(), &strip);
-            self.check(res);
+            let strip = self.tracks[robot][k].path.strip();
+            rows::strips(&mut self.rec, &est_path, [strip], c);
         }
     }
 
     fn log_estimate(&mut self, path: &str, e: &PoseEstimate, c: rerun::Color) {
-        let res = self.rec.log(path, &arrow(&e.pose, 0.45, c));
-        self.check(res);
+        rows::arrow(&mut self.rec, path, &e.pose, 0.45, c);
         let p = &e.pose;
         let strips: Vec<Vec<[f32; 3]>> = [
             belief::ellipse_2sigma(p.x, p.y, &e.covariance, 36),
@@ -364,11 +349,7 @@ impl RrdRecorder {
         .flatten()
         .collect();
         if !strips.is_empty() {
-            let res = self.rec.log(
-                format!("{path}/covariance"),
-                &rerun::LineStrips3D::new(strips).with_colors([c]),
-            );
-            self.check(res);
+            rows::strips(&mut self.rec, &format!("{path}/covariance"), strips, c);
         }
     }
 }
@@ -438,57 +419,48 @@ pub fn record_rrd(
             r.odom_paths[i].push(&o.pose);
         }
         let c = colour(idx.0);
+        let grey = rerun::Color::from_rgb(150, 150, 150);
         if poses_due {
-            let res = r
-                .rec
-                .log(format!("{base}/truth"), &arrow(&truth.pose, 0.5, c));
-            r.check(res);
-            let mut outline: Vec<[f32; 3]> = footprint
-                .outline(&truth.pose)
+            rows::arrow(&mut r.rec, &format!("{base}/truth"), &truth.pose, 0.5, c);
+            let outline = footprint.outline(&truth.pose);
+            let closed = outline
                 .iter()
-                .map(|p| [p[0] as f32, p[1] as f32, 0.0])
-                .collect();
-            outline.push(outline[0]);
-            let body = rerun::LineStrips3D::new([outline])
-                .with_colors([c])
-                .with_labels([id.0.as_str()]);
-            let res = r.rec.log(format!("{base}/body"), &body);
-            r.check(res);
+                .chain(outline.first())
+                .map(|p| [p[0] as f32, p[1] as f32, 0.0]);
+            rows::strips(&mut r.rec, &format!("{base}/body"), [closed], c).with(
+                rerun::LineStrips3D::descriptor_labels(),
+                [rerun::components::Text::from(id.0.as_str())],
+            );
             if let Some(o) = odom {
-                let grey = rerun::Color::from_rgb(150, 150, 150);
-                let res = r
-                    .rec
-                    .log(format!("{base}/odometry"), &arrow(&o.pose, 0.4, grey));
-                r.check(res);
+                rows::arrow(&mut r.rec, &format!("{base}/odometry"), &o.pose, 0.4, grey);
             }
         }
         if paths_due {
-            let strip = rerun::LineStrips3D::new([r.truth_paths[i].strip()]).with_colors([c]);
-            let res = r.rec.log(format!("{base}/truth"), &strip);
-            r.check(res);
+            let strip = r.truth_paths[i].strip();
+            rows::strips(&mut r.rec, &format!("{base}/truth"), [strip], c);
             if odom.is_some() {
-                let strip = rerun::LineStrips3D::new([r.odom_paths[i].strip()])
-                    .with_colors([rerun::Color::from_rgb(150, 150, 150)]);
-                let res = r.rec.log(format!("{base}/odometry"), &strip);
-                r.check(res);
+                let strip = r.odom_paths[i].strip();
+                rows::strips(&mut r.rec, &format!("{base}/odometry"), [strip], grey);
             }
         }
         if scans_due
             && let Some((scans, lt)) = laser
             && let (Some(scan), Some(pose)) = (scans.latest(), &lt.latest)
         {
-            let res = r
-                .rec
-                .log(format!("{base}/scan"), &scan_cloud(scan, pose, c));
-            r.check(res);
+            rows::points(
+                &mut r.rec,
+                &format!("{base}/scan"),
+                scan_points(scan, pose),
+                0.03,
+            )
+            .with(rerun::Points3D::descriptor_colors(), [c]);
         }
         if scans_due
             && let Some((sonars, readings, st)) = sonar
             && let Some(pose) = &st.latest
         {
-            let echoes = sonar_echoes(sonars, &readings.latest, pose, c);
-            let res = r.rec.log(format!("{base}/sonar"), &echoes);
-            r.check(res);
+            let echoes = sonar_echoes(sonars, &readings.latest, pose);
+            rows::strips(&mut r.rec, &format!("{base}/sonar"), echoes, c);
         }
     }
 }
@@ -512,18 +484,16 @@ fn record_people(
             trail.pop_front();
         }
         trail.push_back(p);
-        let trail: Vec<[f32; 3]> = trail.iter().copied().collect();
         let base = format!("people/{}", id.0);
-        let disc = rerun::Points3D::new([p])
-            .with_radii([person.radius as f32])
-            .with_colors([c])
-            .with_labels([id.0.as_str()]);
-        let res = r.rec.log(base.as_str(), &disc);
-        r.check(res);
+        rows::points(&mut r.rec, &base, [p], person.radius as f32)
+            .with(rerun::Points3D::descriptor_colors(), [c])
+            .with(
+                rerun::Points3D::descriptor_labels(),
+                [rerun::components::Text::from(id.0.as_str())],
+            );
         if trail.len() >= 2 {
-            let strip = rerun::LineStrips3D::new([trail]).with_colors([c]);
-            let res = r.rec.log(format!("{base}/trail"), &strip);
-            r.check(res);
+            let strip: Vec<[f32; 3]> = trail.iter().copied().collect();
+            rows::strips(&mut r.rec, &format!("{base}/trail"), [strip], c);
         }
     }
 }

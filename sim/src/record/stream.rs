@@ -1,68 +1,237 @@
-//! The .rrd's rows gathered into Rerun chunks by the recorder itself.
+//! The .rrd's rows gathered into Rerun chunks by the recorder itself, column by column.
 //!
 //! `RecordingStream::log` hands every row to the SDK's batcher thread (a channel send and, as
-//! the batcher sleeps between rows, a thread wake-up per row), which then groups rows of an
-//! entity into chunks. A fast run logs tens of thousands of rows per simulated minute, so that
-//! per-row hand-over cost more than the simulation of an outdoor run. [`RrdStream`] keeps one
-//! [`rerun::log::Chunk`] builder per entity instead and sends a chunk when it holds
-//! [`CHUNK_ROWS`] rows or [`CHUNK_BYTES`] of data, and every builder when the recording is
-//! flushed ([`RrdStream::flush_blocking`], done by [`super::rrd::close_recording`] at the end
-//! of a run, also an interrupted one). A full builder goes to a thread of the stream that
-//! builds the chunk (concatenating the rows' arrays) and hands it to the SDK, so the
-//! simulation thread only serializes rows.
+//! the batcher sleeps between rows, a thread wake-up per row), and a Rerun archetype serializes
+//! each of its components to a small Arrow array when it is built (about 5 µs for a row of a
+//! few components, most of it allocating those arrays). A fast run logs tens of thousands of
+//! rows per simulated minute, so both cost more than the simulation of an outdoor run.
+//! [`RrdStream`] keeps the rows of each entity as columns instead:
+//! - [`RrdStream::row`] appends plain component values (`Position3D`, `Color`, `Scalar`, …) to
+//!   one `Vec` per component; the whole column is serialized once per chunk, so a row costs a
+//!   few pushes;
+//! - [`RrdStream::log`] takes any archetype (serialized as usual) for the rarer rows.
+//!
+//! An entity's rows go out as one chunk when they reach [`CHUNK_ROWS`] rows or [`CHUNK_BYTES`]
+//! of data, and every entity's when the recording is flushed ([`RrdStream::flush_blocking`],
+//! done by [`super::rrd::close_recording`] at the end of a run, also an interrupted one). A full
+//! set of columns goes to a thread of the stream that serializes them, builds the chunk and
+//! hands it to the SDK.
 //!
 //! Rows carry only the `sim_time` timeline (no wall-clock `log_time`/`log_tick`), so two runs
 //! of a scenario give the same rows and the viewer opens on simulated time.
 
-use re_chunk::{Chunk, ChunkBuilder, RowId};
-use rerun::{AsComponents, EntityPath, RecordingStream, RecordingStreamResult, TimeCell};
+use re_chunk::{Chunk, ChunkComponents, ChunkId, TimeColumn};
+use rerun::external::arrow;
+use rerun::{
+    AsComponents, ComponentDescriptor, EntityPath, Loggable, RecordingStream,
+    RecordingStreamResult, SerializedComponentColumn,
+};
+use std::any::Any;
 use std::collections::HashMap;
-use std::sync::mpsc;
+use std::sync::{Arc, mpsc};
 use std::thread::JoinHandle;
 
 /// Rows per chunk at most.
 pub const CHUNK_ROWS: usize = 4096;
 /// Component data per chunk at most (bytes, approximately).
 pub const CHUNK_BYTES: usize = 1 << 20;
-/// Full builders waiting for the chunk thread at most (the caller waits when there are more).
+/// Full column sets waiting for the chunk thread at most (the caller waits when there are more).
 const QUEUED_CHUNKS: usize = 64;
 
+/// The values of one component column, kept as they came until the chunk is built.
+trait ColumnValues: Any + Send + Sync {
+    /// All values, flat (the rows' lengths are kept by [`Column`]).
+    fn to_arrow(&self) -> Result<arrow::array::ArrayRef, String>;
+}
+
+/// Plain component values ([`RrdStream::row`]).
+impl<C: Loggable> ColumnValues for Vec<C> {
+    fn to_arrow(&self) -> Result<arrow::array::ArrayRef, String> {
+        C::to_arrow(self.iter().map(std::borrow::Cow::Borrowed)).map_err(|e| e.to_string())
+    }
+}
+
+/// Arrays of rows already serialized ([`RrdStream::log`]).
+#[derive(Default)]
+struct Serialized(Vec<arrow::array::ArrayRef>);
+
+impl ColumnValues for Serialized {
+    fn to_arrow(&self) -> Result<arrow::array::ArrayRef, String> {
+        let parts: Vec<&dyn arrow::array::Array> = self.0.iter().map(|a| a.as_ref()).collect();
+        arrow::compute::concat(&parts).map_err(|e| e.to_string())
+    }
+}
+
+/// One component of an entity's pending rows.
+struct Column {
+    descriptor: ComponentDescriptor,
+    /// Values per row, for the rows up to the last one that has this component (a row
+    /// without it reads as null: nothing logged).
+    lengths: Vec<Option<u32>>,
+    values: Box<dyn ColumnValues>,
+}
+
 /// The rows being gathered for one entity.
-struct Pending {
+struct Columns {
     path: EntityPath,
-    builder: Option<ChunkBuilder>,
-    rows: usize,
+    /// `sim_time` of each row (ns).
+    times: Vec<i64>,
+    columns: Vec<Column>,
     bytes: usize,
+}
+
+impl Columns {
+    fn new(path: EntityPath) -> Self {
+        Columns {
+            path,
+            times: Vec::new(),
+            columns: Vec::new(),
+            bytes: 0,
+        }
+    }
+
+    /// The row lengths and values of the column of `descriptor` (created holding `V` when
+    /// new); `None` when it holds another type.
+    fn column<V: ColumnValues + Default>(
+        &mut self,
+        descriptor: &ComponentDescriptor,
+    ) -> Option<(&mut Vec<Option<u32>>, &mut V)> {
+        let k = match self
+            .columns
+            .iter()
+            .position(|c| c.descriptor == *descriptor)
+        {
+            Some(k) => k,
+            None => {
+                self.columns.push(Column {
+                    descriptor: descriptor.clone(),
+                    lengths: Vec::new(),
+                    values: Box::new(V::default()),
+                });
+                self.columns.len() - 1
+            }
+        };
+        let c = &mut self.columns[k];
+        let values = (c.values.as_mut() as &mut dyn Any).downcast_mut::<V>()?;
+        Some((&mut c.lengths, values))
+    }
+
+    /// Serializes the columns into a chunk (rows in time order).
+    fn build(self) -> Result<Chunk, String> {
+        use arrow::array::ListArray;
+        use arrow::buffer::{NullBuffer, OffsetBuffer};
+        let rows = self.times.len();
+        let mut components = ChunkComponents::default();
+        for c in self.columns {
+            let values = c.values.to_arrow()?;
+            let mut lengths = c.lengths;
+            lengths.resize(rows, None);
+            let nulls = lengths
+                .iter()
+                .any(Option::is_none)
+                .then(|| NullBuffer::from_iter(lengths.iter().map(Option::is_some)));
+            let offsets =
+                OffsetBuffer::<i32>::from_lengths(lengths.iter().map(|l| l.unwrap_or(0) as usize));
+            let field = Arc::new(arrow::datatypes::Field::new_list_field(
+                values.data_type().clone(),
+                true,
+            ));
+            let list = ListArray::try_new(field, offsets, values, nulls)
+                .map_err(|e| format!("{}: {e}", c.descriptor))?;
+            components.insert(SerializedComponentColumn::new(list, c.descriptor));
+        }
+        let time = TimeColumn::new(
+            None,
+            rerun::Timeline::new_duration("sim_time"),
+            self.times.into(),
+        );
+        Chunk::from_auto_row_ids(
+            ChunkId::new(),
+            self.path,
+            std::iter::once((*time.timeline().name(), time)).collect(),
+            components,
+        )
+        .map_err(|e| e.to_string())
+    }
+}
+
+/// A row of an entity being filled ([`RrdStream::row`]): component values added with
+/// [`Row::with`].
+pub struct Row<'a> {
+    columns: &'a mut Columns,
+    row: usize,
+    error: &'a mut Option<String>,
+}
+
+impl Row<'_> {
+    /// Sets component `descriptor` of the row to `values` (e.g.
+    /// `Points3D::descriptor_positions()` and `[Position3D::new(x, y, 0.0)]`). A descriptor
+    /// must keep the component type it was first given in a chunk; a row giving another is
+    /// left out of the column and the mismatch reported at the end of the run.
+    pub fn with<C: Loggable>(
+        self,
+        descriptor: ComponentDescriptor,
+        values: impl IntoIterator<Item = C>,
+    ) -> Self {
+        let Some((lengths, vec)) = self.columns.column::<Vec<C>>(&descriptor) else {
+            self.error.get_or_insert_with(|| {
+                format!(
+                    "{}: {descriptor} logged as {} after another type",
+                    self.columns.path,
+                    std::any::type_name::<C>()
+                )
+            });
+            return self;
+        };
+        if lengths.len() > self.row {
+            self.error.get_or_insert_with(|| {
+                format!("{}: {descriptor} given twice in one row", self.columns.path)
+            });
+            return self;
+        }
+        let before = vec.len();
+        let mut bytes = 0;
+        for v in values {
+            bytes += std::mem::size_of::<C>() + v.heap_size_bytes() as usize;
+            vec.push(v);
+        }
+        lengths.resize(self.row, None);
+        lengths.push(Some((vec.len() - before) as u32));
+        self.columns.bytes += bytes;
+        self
+    }
 }
 
 /// A Rerun recording whose temporal rows are chunked here (see the module doc); static rows go
 /// straight to the SDK.
 pub struct RrdStream {
     rec: RecordingStream,
-    /// The `sim_time` of the rows logged next.
-    time: rerun::TimePoint,
+    /// The `sim_time` of the rows logged next (ns).
+    time: i64,
     /// Per entity, in the order of their first row.
-    pending: Vec<Pending>,
-    index: HashMap<EntityPath, usize>,
+    pending: Vec<Columns>,
+    index: HashMap<String, usize>,
+    /// The first error of a row (reported by [`RrdStream::flush_blocking`]).
+    error: Option<String>,
     /// The chunk thread: builds chunks and sends them to the SDK; ends with its first error.
-    chunks: Option<mpsc::SyncSender<ChunkBuilder>>,
+    chunks: Option<mpsc::SyncSender<Columns>>,
     chunker: Option<JoinHandle<Option<String>>>,
 }
 
 impl RrdStream {
     pub fn new(rec: RecordingStream) -> Self {
-        let (chunks, queue) = mpsc::sync_channel::<ChunkBuilder>(QUEUED_CHUNKS);
+        let (chunks, queue) = mpsc::sync_channel::<Columns>(QUEUED_CHUNKS);
         let sdk = rec.clone();
         // without the thread, chunks are built on the caller's thread
         let chunker = std::thread::Builder::new()
             .name("rrd chunks".into())
             .spawn(move || {
                 let mut error = None;
-                for builder in queue {
-                    match builder.build() {
+                for columns in queue {
+                    match columns.build() {
                         Ok(chunk) => sdk.send_chunk(chunk),
                         Err(e) => {
-                            error.get_or_insert_with(|| e.to_string());
+                            error.get_or_insert(e);
                         }
                     }
                 }
@@ -71,9 +240,10 @@ impl RrdStream {
             .ok();
         RrdStream {
             rec,
-            time: sim_time(0.0),
+            time: 0,
             pending: Vec::new(),
             index: HashMap::new(),
+            error: None,
             chunks: chunker.as_ref().map(|_| chunks),
             chunker,
         }
@@ -83,47 +253,71 @@ impl RrdStream {
     /// recording's only timeline).
     pub fn set_duration_secs(&mut self, timeline: &str, secs: f64) {
         debug_assert_eq!(timeline, "sim_time");
-        self.time = sim_time(secs);
+        self.time = sim_time_nanos(secs);
+    }
+
+    /// Starts a row of entity `path` at the current time; its components are added with
+    /// [`Row::with`].
+    pub fn row(&mut self, path: &str) -> Row<'_> {
+        let k = match self.index.get(path) {
+            Some(&k) => k,
+            None => {
+                self.index.insert(path.to_string(), self.pending.len());
+                self.pending.push(Columns::new(EntityPath::from(path)));
+                self.pending.len() - 1
+            }
+        };
+        let full = {
+            let p = &self.pending[k];
+            p.times.len() >= CHUNK_ROWS || p.bytes >= CHUNK_BYTES
+        };
+        if full && let Err(e) = self.send(k) {
+            self.error.get_or_insert(e);
+        }
+        let columns = &mut self.pending[k];
+        columns.times.push(self.time);
+        Row {
+            row: columns.times.len() - 1,
+            columns,
+            error: &mut self.error,
+        }
     }
 
     /// Adds a row of `arch` at `path` at the current time.
     pub fn log(
         &mut self,
-        path: impl Into<EntityPath>,
+        path: impl AsRef<str>,
         arch: &(impl AsComponents + ?Sized),
     ) -> RecordingStreamResult<()> {
-        let path = path.into();
         let batches = arch.as_serialized_batches();
         if batches.is_empty() {
             return Ok(());
         }
-        let bytes: usize = batches
-            .iter()
-            .map(|b| rerun::external::arrow::array::Array::get_array_memory_size(&*b.array))
-            .sum();
-        let k = match self.index.get(&path) {
-            Some(&k) => k,
-            None => {
-                self.index.insert(path.clone(), self.pending.len());
-                self.pending.push(Pending {
-                    path,
-                    builder: None,
-                    rows: 0,
-                    bytes: 0,
+        let row = self.row(path.as_ref());
+        for b in batches {
+            let (n, bytes) = (b.array.len(), b.array.get_array_memory_size());
+            let Some((lengths, values)) = row.columns.column::<Serialized>(&b.descriptor) else {
+                row.error.get_or_insert_with(|| {
+                    format!(
+                        "{}: {} logged as an archetype after plain values",
+                        row.columns.path, b.descriptor
+                    )
                 });
-                self.pending.len() - 1
+                continue;
+            };
+            if lengths.len() > row.row {
+                row.error.get_or_insert_with(|| {
+                    format!(
+                        "{}: {} given twice in one row",
+                        row.columns.path, b.descriptor
+                    )
+                });
+                continue;
             }
-        };
-        let p = &mut self.pending[k];
-        let builder = p
-            .builder
-            .take()
-            .unwrap_or_else(|| Chunk::builder(p.path.clone()));
-        p.builder = Some(builder.with_serialized_batches(RowId::new(), self.time.clone(), batches));
-        p.rows += 1;
-        p.bytes += bytes;
-        if p.rows >= CHUNK_ROWS || p.bytes >= CHUNK_BYTES {
-            return self.send(k);
+            lengths.resize(row.row, None);
+            lengths.push(Some(n as u32));
+            values.0.push(b.array);
+            row.columns.bytes += bytes;
         }
         Ok(())
     }
@@ -137,33 +331,32 @@ impl RrdStream {
         self.rec.log_static(path, arch)
     }
 
-    /// Sends the chunk gathered for entity `k` (to the chunk thread while it runs).
-    fn send(&mut self, k: usize) -> RecordingStreamResult<()> {
+    /// Sends the rows gathered for entity `k` (to the chunk thread while it runs).
+    fn send(&mut self, k: usize) -> Result<(), String> {
         let p = &mut self.pending[k];
-        p.rows = 0;
-        p.bytes = 0;
-        let Some(builder) = p.builder.take() else {
+        if p.times.is_empty() {
             return Ok(());
-        };
-        let builder = match &self.chunks {
-            Some(chunks) => match chunks.send(builder) {
+        }
+        let columns = std::mem::replace(p, Columns::new(p.path.clone()));
+        let columns = match &self.chunks {
+            Some(chunks) => match chunks.send(columns) {
                 Ok(()) => return Ok(()),
-                Err(mpsc::SendError(builder)) => builder,
+                Err(mpsc::SendError(columns)) => columns,
             },
-            None => builder,
+            None => columns,
         };
-        self.rec.send_chunk(builder.build()?);
+        self.rec.send_chunk(columns.build()?);
         Ok(())
     }
 
-    /// Sends every chunk being gathered, ends the chunk thread and waits until the SDK has
-    /// written everything; the first error, if any. Rows logged afterwards are chunked on the
-    /// caller's thread.
+    /// Sends every entity's rows, ends the chunk thread and waits until the SDK has written
+    /// everything; the first error, if any. Rows logged afterwards are chunked on the caller's
+    /// thread.
     pub fn flush_blocking(&mut self) -> Result<(), String> {
-        let mut first: Option<String> = None;
+        let mut first = self.error.take();
         for k in 0..self.pending.len() {
             if let Err(e) = self.send(k) {
-                first.get_or_insert_with(|| e.to_string());
+                first.get_or_insert(e);
             }
         }
         self.chunks = None;
@@ -185,16 +378,17 @@ impl RrdStream {
     }
 }
 
-/// A time point on the `sim_time` timeline (s), as `RecordingStream::set_duration_secs` makes
-/// it.
-fn sim_time(secs: f64) -> rerun::TimePoint {
+/// Simulated time `secs` on the `sim_time` timeline (ns), as `RecordingStream::set_duration_secs`
+/// makes it.
+fn sim_time_nanos(secs: f64) -> i64 {
     let d = std::time::Duration::try_from_secs_f64(secs).unwrap_or_default();
-    rerun::TimePoint::from([("sim_time", TimeCell::from(d))])
+    i64::try_from(d.as_nanos()).unwrap_or(i64::MAX)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use arrow::array::Array;
     use rerun::log::LogMsg;
 
     /// (entity, rows, timelines) of every data chunk of `msgs`, in order.
@@ -211,6 +405,121 @@ mod tests {
                 (c.entity_path().to_string(), c.num_rows(), t)
             })
             .collect()
+    }
+
+    /// The data chunks of entity `path` in `msgs`.
+    fn entity_chunks(msgs: &[LogMsg], path: &str) -> Vec<Chunk> {
+        msgs.iter()
+            .filter_map(|m| match m {
+                LogMsg::ArrowMsg(_, a) => Chunk::from_arrow_msg(a).ok(),
+                _ => None,
+            })
+            .filter(|c| c.entity_path().to_string() == path)
+            .collect()
+    }
+
+    #[test]
+    fn plain_values_give_the_columns_of_the_archetypes() {
+        use rerun::components::{Color, LineStrip3D, Position3D, Radius, Text};
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("test").memory().unwrap();
+        let mut s = RrdStream::new(rec);
+        let c = Color::from_rgb(1, 2, 3);
+        for k in 0..5 {
+            let x = k as f32;
+            s.set_duration_secs("sim_time", 0.5 * k as f64);
+            // the same rows as archetypes ...
+            s.log(
+                "arch",
+                &rerun::Points3D::new([[x, 1.0, 0.0], [x, 2.0, 0.0]])
+                    .with_radii([0.3])
+                    .with_colors([c])
+                    .with_labels([format!("p{k}")]),
+            )
+            .unwrap();
+            // ... and as plain values
+            s.row("plain")
+                .with(
+                    rerun::Points3D::descriptor_positions(),
+                    [Position3D::new(x, 1.0, 0.0), Position3D::new(x, 2.0, 0.0)],
+                )
+                .with(rerun::Points3D::descriptor_radii(), [Radius::from(0.3)])
+                .with(rerun::Points3D::descriptor_colors(), [c])
+                .with(
+                    rerun::Points3D::descriptor_labels(),
+                    [Text::from(format!("p{k}"))],
+                );
+            // every other row without the strip: a null there, not an empty list
+            if k % 2 == 0 {
+                s.log(
+                    "arch",
+                    &rerun::LineStrips3D::new([[[x, 0.0, 0.0], [0.0, x, 0.0]]]),
+                )
+                .unwrap();
+                s.row("plain").with(
+                    rerun::LineStrips3D::descriptor_strips(),
+                    [LineStrip3D::from([[x, 0.0, 0.0], [0.0, x, 0.0]])],
+                );
+            }
+        }
+        s.flush_blocking().unwrap();
+        let msgs = storage.take();
+        let (arch, plain) = (
+            entity_chunks(&msgs, "/arch"),
+            entity_chunks(&msgs, "/plain"),
+        );
+        assert_eq!((arch.len(), plain.len()), (1, 1));
+        let (a, p) = (&arch[0], &plain[0]);
+        assert_eq!((a.num_rows(), p.num_rows()), (8, 8));
+        assert_eq!(
+            a.timelines()[&"sim_time".into()].times_raw(),
+            p.timelines()[&"sim_time".into()].times_raw()
+        );
+        let mut descriptors: Vec<_> = p.components().component_descriptors().cloned().collect();
+        descriptors.sort_by_key(|d| d.to_string());
+        let mut expected: Vec<_> = a.components().component_descriptors().cloned().collect();
+        expected.sort_by_key(|d| d.to_string());
+        assert_eq!(descriptors, expected);
+        for d in &descriptors {
+            let (x, y) = (
+                a.components().get_array(d.component).unwrap(),
+                p.components().get_array(d.component).unwrap(),
+            );
+            assert_eq!(x.to_data(), y.to_data(), "{d}");
+        }
+    }
+
+    #[test]
+    fn a_component_given_twice_or_with_another_type_is_reported_and_left_out() {
+        use rerun::components::{Radius, Scalar};
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("test").memory().unwrap();
+        let mut s = RrdStream::new(rec);
+        s.row("x")
+            .with(rerun::Scalars::descriptor_scalars(), [Scalar::from(1.0)])
+            .with(rerun::Scalars::descriptor_scalars(), [Scalar::from(2.0)]);
+        s.row("x")
+            .with(rerun::Scalars::descriptor_scalars(), [Radius::from(3.0)]);
+        let e = s.flush_blocking().unwrap_err();
+        assert!(e.contains("/x") && e.contains("twice in one row"), "{e}");
+        let msgs = storage.take();
+        let chunk = &entity_chunks(&msgs, "/x")[0];
+        let values = chunk
+            .components()
+            .get_array(rerun::Scalars::descriptor_scalars().component)
+            .unwrap();
+        // the first value of the first row; the second row has none
+        assert_eq!(
+            (values.len(), values.value_length(0), values.is_null(1)),
+            (2, 1, true)
+        );
+        // the type mismatch alone is reported too
+        let (rec, _storage) = rerun::RecordingStreamBuilder::new("test").memory().unwrap();
+        let mut s = RrdStream::new(rec);
+        s.row("x")
+            .with(rerun::Scalars::descriptor_scalars(), [Scalar::from(1.0)]);
+        s.row("x")
+            .with(rerun::Scalars::descriptor_scalars(), [Radius::from(3.0)]);
+        let e = s.flush_blocking().unwrap_err();
+        assert!(e.contains("after another type"), "{e}");
     }
 
     #[test]
