@@ -18,6 +18,7 @@
 //! the horizon (a third of the image from the top) is in view.
 
 pub mod render;
+mod shade;
 
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;

@@ -16,6 +16,7 @@
 //! A plain function over slices: no allocation, no ECS.
 
 use super::GroundRays;
+use super::shade::{self, Rgb};
 use crate::core::Pose2;
 use crate::world::roads::surface_raster::{CLASSES, GRASS, SurfaceRaster};
 use rayon::prelude::*;
@@ -138,6 +139,10 @@ pub struct FrameView<'a> {
     /// ... and the pose's cell position.
     o: [f32; 2],
     noise_scale: f32,
+    /// Per surface class: base colour, mottle amplitude and joint factor.
+    base: [Rgb; CLASSES],
+    mottle: [Rgb; CLASSES],
+    joints: [f32; CLASSES],
 }
 
 impl<'a> FrameView<'a> {
@@ -166,6 +171,9 @@ impl<'a> FrameView<'a> {
                 ((pose.y - raster.origin[1]) * inv) as f32,
             ],
             noise_scale: frame.noise_std / TRIANGULAR_STD,
+            base: std::array::from_fn(|k| shade::rgb(palette.classes[k].base)),
+            mottle: std::array::from_fn(|k| shade::rgb(palette.classes[k].mottle)),
+            joints: std::array::from_fn(|k| palette.classes[k].joints),
         }
     }
 
@@ -184,7 +192,7 @@ impl<'a> FrameView<'a> {
         let i = v as usize * w + u as usize;
         let first = self.rays.first_ground_row;
         if v < first {
-            self.shade(self.sky(v), i)
+            self.shade(shade::rgb(self.sky(v)), i)
         } else {
             self.ground(&self.rays.offsets[i - first as usize * w], i)
         }
@@ -209,7 +217,7 @@ impl<'a> FrameView<'a> {
         let first = (self.rays.first_ground_row as usize).min(h);
         let (sky, ground) = out.split_at_mut(3 * first * w);
         for (v, line) in sky.chunks_exact_mut(3 * w).enumerate() {
-            let c = self.sky(v as u32);
+            let c = shade::rgb(self.sky(v as u32));
             for (u, px) in line.chunks_exact_mut(3).enumerate() {
                 px.copy_from_slice(&self.shade(c, v * w + u));
             }
@@ -293,27 +301,21 @@ impl<'a> FrameView<'a> {
     /// ([`mottle`]) on a paving joint or not ([`joint`]).
     #[inline(always)]
     fn coloured(&self, class: u8, m: f32, on_joint: bool, i: usize) -> [u8; 3] {
-        let cc = &self.palette.classes[class as usize];
-        let j_factor = if cc.joints != 1.0 && on_joint {
-            cc.joints
+        let k = class as usize;
+        let joints = self.joints[k];
+        let j_factor = if joints != 1.0 && on_joint {
+            joints
         } else {
             1.0
         };
-        let col: [f32; 3] =
-            std::array::from_fn(|k| (cc.base[k] + 2.0 * m * cc.mottle[k]) * j_factor);
-        self.shade(col, i)
+        self.shade(shade::mottled(self.base[k], self.mottle[k], m, j_factor), i)
     }
 
     /// Colour `c` of pixel index `i` with the frame's brightness and the pixel's own noise.
     #[inline(always)]
-    fn shade(&self, c: [f32; 3], i: usize) -> [u8; 3] {
+    fn shade(&self, c: Rgb, i: usize) -> [u8; 3] {
         let n = mix64(self.frame.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        std::array::from_fn(|k| {
-            let a = ((n >> (16 * k)) & 0xff) as f32;
-            let b = ((n >> (16 * k + 8)) & 0xff) as f32;
-            let v = c[k] * self.frame.brightness + (a + b - 255.0) * self.noise_scale;
-            v.clamp(0.0, 255.0) as u8
-        })
+        shade::shade(c, n, self.frame.brightness, self.noise_scale)
     }
 }
 
