@@ -24,7 +24,7 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
+use std::sync::{Mutex, mpsc};
 use std::thread::JoinHandle;
 
 /// The MCAP profile of ROS 2 recordings.
@@ -83,6 +83,10 @@ pub struct McapRecorder {
     /// What is gathered for the writer thread.
     batch: Batch,
     jobs: Option<mpsc::SyncSender<Batch>>,
+    /// Batches the writer thread is done with, emptied, for their allocations (a batch that
+    /// grew from nothing each time would copy its data over and over as it grew). In a mutex
+    /// only because a resource must be `Sync`; reached through `&mut`.
+    spare: Mutex<mpsc::Receiver<Batch>>,
     worker: Option<JoinHandle<anyhow::Result<McapStats>>>,
 }
 
@@ -160,9 +164,10 @@ impl McapRecorder {
             latest_ns: 0,
         };
         let (jobs, queue) = mpsc::sync_channel(QUEUED_BATCHES);
+        let (done, spare) = mpsc::channel();
         let worker = std::thread::Builder::new()
             .name("mcap writer".into())
-            .spawn(move || file.run(queue))
+            .spawn(move || file.run(queue, done))
             .map_err(|e| anyhow!("{}: cannot start the writer thread: {e}", path.display()))?;
         Ok(McapRecorder {
             path: path.to_path_buf(),
@@ -170,6 +175,7 @@ impl McapRecorder {
             topics: HashMap::new(),
             batch: Batch::default(),
             jobs: Some(jobs),
+            spare: Mutex::new(spare),
             worker: Some(worker),
         })
     }
@@ -189,7 +195,9 @@ impl McapRecorder {
         if self.batch.ops.is_empty() {
             return Ok(());
         }
-        let batch = std::mem::take(&mut self.batch);
+        let spare = self.spare.get_mut().unwrap_or_else(|e| e.into_inner());
+        let next = spare.try_recv().unwrap_or_default();
+        let batch = std::mem::replace(&mut self.batch, next);
         let sent = self.jobs.as_ref().is_some_and(|j| j.send(batch).is_ok());
         if sent { Ok(()) } else { Err(self.stopped()) }
     }
@@ -347,11 +355,16 @@ struct FileWriter {
 
 impl FileWriter {
     /// The writer thread: the batches in order until the recorder hangs up, then the summary.
-    fn run(mut self, queue: mpsc::Receiver<Batch>) -> anyhow::Result<McapStats> {
+    /// Each batch done goes back emptied through `done`.
+    fn run(
+        mut self,
+        queue: mpsc::Receiver<Batch>,
+        done: mpsc::Sender<Batch>,
+    ) -> anyhow::Result<McapStats> {
         let mut error: Option<anyhow::Error> = None;
-        for batch in queue {
+        for mut batch in queue {
             let mut start = 0;
-            for op in batch.ops {
+            for op in batch.ops.drain(..) {
                 match op {
                     Op::Message {
                         channel,
@@ -416,6 +429,9 @@ impl FileWriter {
                     }
                 }
             }
+            batch.data.clear();
+            // the recorder may be gone already (its last batch)
+            let _ = done.send(batch);
         }
         match error {
             Some(e) => Err(e),
