@@ -169,36 +169,43 @@ impl Row<'_> {
     /// must keep the component type it was first given in a chunk; a row giving another is
     /// left out of the column and the mismatch reported at the end of the run.
     pub fn with<C: Loggable>(
-        self,
+        mut self,
         descriptor: ComponentDescriptor,
         values: impl IntoIterator<Item = C>,
     ) -> Self {
-        let Some((lengths, vec)) = self.columns.column::<Vec<C>>(&descriptor) else {
-            self.error.get_or_insert_with(|| {
-                format!(
-                    "{}: {descriptor} logged as {} after another type",
-                    self.columns.path,
-                    std::any::type_name::<C>()
-                )
-            });
-            return self;
-        };
-        if lengths.len() > self.row {
-            self.error.get_or_insert_with(|| {
-                format!("{}: {descriptor} given twice in one row", self.columns.path)
-            });
-            return self;
-        }
-        let before = vec.len();
-        let mut bytes = 0;
-        for v in values {
-            bytes += std::mem::size_of::<C>() + v.heap_size_bytes() as usize;
-            vec.push(v);
-        }
-        lengths.resize(self.row, None);
-        lengths.push(Some((vec.len() - before) as u32));
-        self.columns.bytes += bytes;
+        self.put(&descriptor, |vec: &mut Vec<C>| {
+            let before = vec.len();
+            let mut bytes = 0;
+            for v in values {
+                bytes += std::mem::size_of::<C>() + v.heap_size_bytes() as usize;
+                vec.push(v);
+            }
+            (vec.len() - before, bytes)
+        });
         self
+    }
+
+    /// Adds this row's entry of column `descriptor` (holding `V`): `fill` appends the values
+    /// and returns (how many, bytes). A column of another type, or one this row has already
+    /// set, is left alone and the problem reported at the end of the run.
+    fn put<V: ColumnValues + Default>(
+        &mut self,
+        descriptor: &ComponentDescriptor,
+        fill: impl FnOnce(&mut V) -> (usize, usize),
+    ) {
+        let problem = match self.columns.column::<V>(descriptor) {
+            None => "logged after another type in this chunk",
+            Some((lengths, _)) if lengths.len() > self.row => "given twice in one row",
+            Some((lengths, values)) => {
+                let (n, bytes) = fill(values);
+                lengths.resize(self.row, None);
+                lengths.push(Some(n as u32));
+                self.columns.bytes += bytes;
+                return;
+            }
+        };
+        self.error
+            .get_or_insert_with(|| format!("{}: {descriptor} {problem}", self.columns.path));
     }
 }
 
@@ -293,31 +300,13 @@ impl RrdStream {
         if batches.is_empty() {
             return Ok(());
         }
-        let row = self.row(path.as_ref());
+        let mut row = self.row(path.as_ref());
         for b in batches {
-            let (n, bytes) = (b.array.len(), b.array.get_array_memory_size());
-            let Some((lengths, values)) = row.columns.column::<Serialized>(&b.descriptor) else {
-                row.error.get_or_insert_with(|| {
-                    format!(
-                        "{}: {} logged as an archetype after plain values",
-                        row.columns.path, b.descriptor
-                    )
-                });
-                continue;
-            };
-            if lengths.len() > row.row {
-                row.error.get_or_insert_with(|| {
-                    format!(
-                        "{}: {} given twice in one row",
-                        row.columns.path, b.descriptor
-                    )
-                });
-                continue;
-            }
-            lengths.resize(row.row, None);
-            lengths.push(Some(n as u32));
-            values.0.push(b.array);
-            row.columns.bytes += bytes;
+            row.put(&b.descriptor, |values: &mut Serialized| {
+                let (n, bytes) = (b.array.len(), b.array.get_array_memory_size());
+                values.0.push(b.array);
+                (n, bytes)
+            });
         }
         Ok(())
     }
