@@ -209,3 +209,49 @@ fn pixels_read_one_by_one_equal_the_rendered_image() {
         }
     }
 }
+
+#[test]
+fn whole_rows_with_and_without_avx2_are_the_same_bytes() {
+    let (_, park) = park_fixture();
+    // a small raster, so that cameras see its edges, its last cells and beyond
+    let small = {
+        let mut r = SurfaceRaster::empty();
+        (r.width, r.height, r.resolution) = (37, 23, 0.05);
+        r.cells = (0..r.width * r.height).map(|k| (k % 8) as u8).collect();
+        r
+    };
+    let odd = CameraSpec {
+        width: 317,
+        height: 61,
+        ..CameraSpec::default()
+    };
+    let mut checked = 0;
+    for (spec, raster) in [
+        (CameraSpec::default(), park.as_ref()),
+        (odd, park.as_ref()),
+        (CameraSpec::default(), &small),
+    ] {
+        for seed in 0..4 {
+            let mut cam = Camera::new(spec.clone(), stream_rng(seed, "r", "camera"));
+            let poses = [
+                park_pose("82", "15", 3.0, 0.0),
+                park_pose("82", "15", 8.0, 4.0),
+                Pose2::new(1.2, 0.6, 2.5),
+                Pose2::new(2.0, 1.0, -0.4),
+                Pose2::new(-3.0, -2.0, 0.7),
+                Pose2::new(1e12, 0.0, 0.0),
+            ];
+            for pose in poses {
+                let frame = cam.take(0.0, pose);
+                let view = cam.view(&frame, raster).pixels;
+                let mut rows = vec![0; (spec.width * spec.height * 3) as usize];
+                let mut portable = rows.clone();
+                view.render_here(&mut rows);
+                view.without_avx2().render_here(&mut portable);
+                assert_eq!(rows, portable, "seed {seed}, pose {pose:?}");
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 3 * 4 * 6);
+}

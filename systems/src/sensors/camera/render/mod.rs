@@ -13,7 +13,11 @@
 //!   frame, yet deterministic;
 //! - **brightness**: one factor per frame scales the whole image (clouds, auto-exposure).
 //!
-//! A plain function over slices: no allocation, no ECS.
+//! Whole images render row by row; with AVX2 (detected at run time) eight pixels at a time
+//! (`render/avx2.rs`), with the same bytes. A plain function over slices: no allocation, no ECS.
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 
 use super::GroundRays;
 use super::shade::{self, Rgb};
@@ -143,6 +147,19 @@ pub struct FrameView<'a> {
     base: [Rgb; CLASSES],
     mottle: [Rgb; CLASSES],
     joints: [f32; CLASSES],
+    /// The same per channel, for eight lanes of classes.
+    tables: ClassTables,
+    /// Render whole rows with AVX2 (detected at run time; `render/avx2.rs`).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    avx2: bool,
+}
+
+/// Colours by class, one table per channel: `base[channel][class]`.
+#[derive(Clone, Copy, Debug)]
+struct ClassTables {
+    base: [[f32; CLASSES]; 3],
+    mottle: [[f32; CLASSES]; 3],
+    joint: [f32; CLASSES],
 }
 
 impl<'a> FrameView<'a> {
@@ -174,7 +191,32 @@ impl<'a> FrameView<'a> {
             base: std::array::from_fn(|k| shade::rgb(palette.classes[k].base)),
             mottle: std::array::from_fn(|k| shade::rgb(palette.classes[k].mottle)),
             joints: std::array::from_fn(|k| palette.classes[k].joints),
+            tables: ClassTables {
+                base: std::array::from_fn(|c| std::array::from_fn(|k| palette.classes[k].base[c])),
+                mottle: std::array::from_fn(|c| {
+                    std::array::from_fn(|k| palette.classes[k].mottle[c])
+                }),
+                joint: std::array::from_fn(|k| palette.classes[k].joints),
+            },
+            avx2: Self::has_avx2() && raster.cells.len() < i32::MAX as usize,
         }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    fn has_avx2() -> bool {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    fn has_avx2() -> bool {
+        false
+    }
+
+    /// The same view rendering whole rows without AVX2 (tests: both give the same bytes).
+    #[cfg(test)]
+    pub(crate) fn without_avx2(mut self) -> Self {
+        self.avx2 = false;
+        self
     }
 
     pub fn width(&self) -> u32 {
@@ -217,30 +259,10 @@ impl<'a> FrameView<'a> {
         let first = (self.rays.first_ground_row as usize).min(h);
         let (sky, ground) = out.split_at_mut(3 * first * w);
         for (v, line) in sky.chunks_exact_mut(3 * w).enumerate() {
-            let c = shade::rgb(self.sky(v as u32));
-            for (u, px) in line.chunks_exact_mut(3).enumerate() {
-                px.copy_from_slice(&self.shade(c, v * w + u));
-            }
+            self.sky_row(line, self.sky(v as u32), v * w);
         }
-        // in blocks: first every pixel's cell (independent raster reads the CPU overlaps),
-        // then the colours
         let render_row = |(row, (line, offsets)): (usize, (&mut [u8], &[[f32; 2]]))| {
-            let mut i = (first + row) * w;
-            let mut cells = [(0, 0, 0); BLOCK];
-            // neighbouring pixels near the camera see the same cell: its mottle once
-            let mut last = (i32::MIN, i32::MIN, 0.0);
-            for (px, rays) in line.chunks_mut(3 * BLOCK).zip(offsets.chunks(BLOCK)) {
-                for (c, ray) in cells.iter_mut().zip(rays) {
-                    *c = self.cell(ray);
-                }
-                for (px, &(ix, iy, class)) in px.chunks_exact_mut(3).zip(&cells) {
-                    if (ix, iy) != (last.0, last.1) {
-                        last = (ix, iy, mottle(ix, iy));
-                    }
-                    px.copy_from_slice(&self.coloured(class, last.2, joint(ix, iy), i));
-                    i += 1;
-                }
-            }
+            self.ground_row(line, offsets, (first + row) * w);
         };
         if parallel {
             ground
@@ -255,6 +277,47 @@ impl<'a> FrameView<'a> {
                 .zip(self.rays.offsets.chunks(w))
                 .enumerate()
                 .for_each(render_row);
+        }
+    }
+
+    /// A sky row of colour `colour` into `line`, its first pixel having index `i`.
+    fn sky_row(&self, line: &mut [u8], colour: [f32; 3], i: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: AVX2 was detected in `new`
+            unsafe { self.sky_row_avx2(line, colour, i) };
+            return;
+        }
+        let c = shade::rgb(colour);
+        for (u, px) in line.chunks_exact_mut(3).enumerate() {
+            px.copy_from_slice(&self.shade(c, i + u));
+        }
+    }
+
+    /// A ground row into `line` from its rays, its first pixel having index `i`.
+    fn ground_row(&self, line: &mut [u8], rays: &[[f32; 2]], mut i: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: AVX2 was detected in `new`, which checked the raster's size
+            unsafe { self.ground_row_avx2(line, rays, i) };
+            return;
+        }
+        // in blocks: first every pixel's cell (independent raster reads the CPU overlaps),
+        // then the colours
+        let mut cells = [(0, 0, 0); BLOCK];
+        // neighbouring pixels near the camera see the same cell: its mottle once
+        let mut last = (i32::MIN, i32::MIN, 0.0);
+        for (px, rays) in line.chunks_mut(3 * BLOCK).zip(rays.chunks(BLOCK)) {
+            for (c, ray) in cells.iter_mut().zip(rays) {
+                *c = self.cell(ray);
+            }
+            for (px, &(ix, iy, class)) in px.chunks_exact_mut(3).zip(&cells) {
+                if (ix, iy) != (last.0, last.1) {
+                    last = (ix, iy, mottle(ix, iy));
+                }
+                px.copy_from_slice(&self.coloured(class, last.2, joint(ix, iy), i));
+                i += 1;
+            }
         }
     }
 
@@ -314,8 +377,18 @@ impl<'a> FrameView<'a> {
     /// Colour `c` of pixel index `i` with the frame's brightness and the pixel's own noise.
     #[inline(always)]
     fn shade(&self, c: Rgb, i: usize) -> [u8; 3] {
-        let n = mix64(self.frame.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        shade::shade(c, n, self.frame.brightness, self.noise_scale)
+        shade::shade(
+            c,
+            self.noise_word(i),
+            self.frame.brightness,
+            self.noise_scale,
+        )
+    }
+
+    /// The noise word of pixel index `i`: a hash of the frame's seed and `i`.
+    #[inline(always)]
+    fn noise_word(&self, i: usize) -> u64 {
+        mix64(self.frame.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
     }
 }
 
