@@ -143,11 +143,10 @@ pub struct FrameView<'a> {
     /// ... and the pose's cell position.
     o: [f32; 2],
     noise_scale: f32,
-    /// Per surface class: base colour, mottle amplitude and joint factor.
+    /// Per surface class: base colour and mottle amplitude ...
     base: [Rgb; CLASSES],
     mottle: [Rgb; CLASSES],
-    joints: [f32; CLASSES],
-    /// The same per channel, for eight lanes of classes.
+    /// ... and the same per channel, for eight lanes of classes, with the joint factors.
     tables: ClassTables,
     /// Render whole rows with AVX2 (detected at run time; `render/avx2.rs`).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
@@ -190,7 +189,6 @@ impl<'a> FrameView<'a> {
             noise_scale: frame.noise_std / TRIANGULAR_STD,
             base: std::array::from_fn(|k| shade::rgb(palette.classes[k].base)),
             mottle: std::array::from_fn(|k| shade::rgb(palette.classes[k].mottle)),
-            joints: std::array::from_fn(|k| palette.classes[k].joints),
             tables: ClassTables {
                 base: std::array::from_fn(|c| std::array::from_fn(|k| palette.classes[k].base[c])),
                 mottle: std::array::from_fn(|c| {
@@ -365,7 +363,7 @@ impl<'a> FrameView<'a> {
     #[inline(always)]
     fn coloured(&self, class: u8, m: f32, on_joint: bool, i: usize) -> [u8; 3] {
         let k = class as usize;
-        let joints = self.joints[k];
+        let joints = self.tables.joint[k];
         let j_factor = if joints != 1.0 && on_joint {
             joints
         } else {
