@@ -210,7 +210,7 @@ impl McapExport {
                 img.height,
                 img.rgb,
             );
-            if let Err(e) = rec.write(ch, stamp_ns(img.stamp), &msg) {
+            if let Err(e) = rec.write_owned(ch, stamp_ns(img.stamp), msg) {
                 self.error = Some(e);
                 return;
             }

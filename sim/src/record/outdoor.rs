@@ -292,7 +292,7 @@ pub fn record_outdoor(
             }
         }
         if let Some(nav) = nav {
-            let start = nav.route_edges().first().copied();
+            let start = nav.route_start_edge();
             let length = nav.route.as_ref().map(|rt| rt.length);
             if nav.route.is_some() && (logged.route_length != length || logged.route_start != start)
             {

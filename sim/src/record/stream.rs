@@ -12,10 +12,13 @@
 //! - [`RrdStream::log`] takes any archetype (serialized as usual) for the rarer rows.
 //!
 //! An entity's rows go out as one chunk when they reach [`CHUNK_ROWS`] rows or [`CHUNK_BYTES`]
-//! of data, and every entity's when the recording is flushed ([`RrdStream::flush_blocking`],
+//! of data or span [`CHUNK_SPAN_S`] of simulated time (so that little is left to build when
+//! the run ends), and every entity's when the recording is flushed ([`RrdStream::flush_blocking`],
 //! done by [`super::rrd::close_recording`] at the end of a run, also an interrupted one). A full
 //! set of columns goes to a thread of the stream that serializes them, builds the chunk and
-//! hands it to the SDK.
+//! hands it to the SDK, then sends the emptied columns back: the entity's next rows fill them,
+//! so a column does not grow again from nothing (copying itself over and over, on fresh
+//! pages) for every chunk.
 //!
 //! Rows carry only the `sim_time` timeline (no wall-clock `log_time`/`log_tick`), so two runs
 //! of a scenario give the same rows and the viewer opens on simulated time.
@@ -35,6 +38,8 @@ use std::thread::JoinHandle;
 pub const CHUNK_ROWS: usize = 4096;
 /// Component data per chunk at most (bytes, approximately).
 pub const CHUNK_BYTES: usize = 1 << 20;
+/// Simulated time (s) from a chunk's first row to its last at most.
+pub const CHUNK_SPAN_S: f64 = 30.0;
 /// Full column sets waiting for the chunk thread at most (the caller waits when there are more).
 const QUEUED_CHUNKS: usize = 64;
 
@@ -42,12 +47,17 @@ const QUEUED_CHUNKS: usize = 64;
 trait ColumnValues: Any + Send + Sync {
     /// All values, flat (the rows' lengths are kept by [`Column`]).
     fn to_arrow(&self) -> Result<arrow::array::ArrayRef, String>;
+    /// Drops the values, keeping the allocation.
+    fn clear(&mut self);
 }
 
 /// Plain component values ([`RrdStream::row`]).
 impl<C: Loggable> ColumnValues for Vec<C> {
     fn to_arrow(&self) -> Result<arrow::array::ArrayRef, String> {
         C::to_arrow(self.iter().map(std::borrow::Cow::Borrowed)).map_err(|e| e.to_string())
+    }
+    fn clear(&mut self) {
+        Vec::clear(self);
     }
 }
 
@@ -60,19 +70,25 @@ impl ColumnValues for Serialized {
         let parts: Vec<&dyn arrow::array::Array> = self.0.iter().map(|a| a.as_ref()).collect();
         arrow::compute::concat(&parts).map_err(|e| e.to_string())
     }
+    fn clear(&mut self) {
+        self.0.clear();
+    }
 }
 
 /// One component of an entity's pending rows.
 struct Column {
     descriptor: ComponentDescriptor,
     /// Values per row, for the rows up to the last one that has this component (a row
-    /// without it reads as null: nothing logged).
+    /// without it reads as null: nothing logged). Empty: no row has it (a column of an earlier
+    /// chunk, kept for its allocation), and the chunk leaves it out.
     lengths: Vec<Option<u32>>,
     values: Box<dyn ColumnValues>,
 }
 
 /// The rows being gathered for one entity.
 struct Columns {
+    /// The entity's index in [`RrdStream::pending`].
+    entity: usize,
     path: EntityPath,
     /// `sim_time` of each row (ns).
     times: Vec<i64>,
@@ -81,8 +97,9 @@ struct Columns {
 }
 
 impl Columns {
-    fn new(path: EntityPath) -> Self {
+    fn new(entity: usize, path: EntityPath) -> Self {
         Columns {
+            entity,
             path,
             times: Vec::new(),
             columns: Vec::new(),
@@ -101,7 +118,14 @@ impl Columns {
             .iter()
             .position(|c| c.descriptor == *descriptor)
         {
-            Some(k) => k,
+            Some(k) => {
+                // a column kept from an earlier chunk takes whatever type this chunk gives it
+                let c = &mut self.columns[k];
+                if c.lengths.is_empty() && !(c.values.as_ref() as &dyn Any).is::<V>() {
+                    c.values = Box::new(V::default());
+                }
+                k
+            }
             None => {
                 self.columns.push(Column {
                     descriptor: descriptor.clone(),
@@ -116,15 +140,27 @@ impl Columns {
         Some((&mut c.lengths, values))
     }
 
-    /// Serializes the columns into a chunk (rows in time order).
-    fn build(self) -> Result<Chunk, String> {
+    /// Serializes the columns into a chunk (rows in time order) and empties them, keeping
+    /// their allocations.
+    fn build(&mut self) -> Result<Chunk, String> {
+        let chunk = self.chunk();
+        self.times.clear();
+        self.bytes = 0;
+        for c in &mut self.columns {
+            c.lengths.clear();
+            c.values.clear();
+        }
+        chunk
+    }
+
+    fn chunk(&mut self) -> Result<Chunk, String> {
         use arrow::array::ListArray;
         use arrow::buffer::{NullBuffer, OffsetBuffer};
         let rows = self.times.len();
         let mut components = ChunkComponents::default();
-        for c in self.columns {
+        for c in self.columns.iter_mut().filter(|c| !c.lengths.is_empty()) {
             let values = c.values.to_arrow()?;
-            let mut lengths = c.lengths;
+            let lengths = &mut c.lengths;
             lengths.resize(rows, None);
             let nulls = lengths
                 .iter()
@@ -138,16 +174,16 @@ impl Columns {
             ));
             let list = ListArray::try_new(field, offsets, values, nulls)
                 .map_err(|e| format!("{}: {e}", c.descriptor))?;
-            components.insert(SerializedComponentColumn::new(list, c.descriptor));
+            components.insert(SerializedComponentColumn::new(list, c.descriptor.clone()));
         }
         let time = TimeColumn::new(
             None,
             rerun::Timeline::new_duration("sim_time"),
-            self.times.into(),
+            self.times.clone().into(),
         );
         Chunk::from_auto_row_ids(
             ChunkId::new(),
-            self.path,
+            self.path.clone(),
             std::iter::once((*time.timeline().name(), time)).collect(),
             components,
         )
@@ -175,12 +211,11 @@ impl Row<'_> {
     ) -> Self {
         self.put(&descriptor, |vec: &mut Vec<C>| {
             let before = vec.len();
-            let mut bytes = 0;
-            for v in values {
-                bytes += std::mem::size_of::<C>() + v.heap_size_bytes() as usize;
-                vec.push(v);
-            }
-            (vec.len() - before, bytes)
+            // `extend` reserves for the whole row at once (a particle set is a thousand values)
+            vec.extend(values);
+            let row = &vec[before..];
+            let heap: u64 = row.iter().map(|v| v.heap_size_bytes()).sum();
+            (row.len(), std::mem::size_of_val(row) + heap as usize)
         });
         self
     }
@@ -223,24 +258,34 @@ pub struct RrdStream {
     /// The chunk thread: builds chunks and sends them to the SDK; ends with its first error.
     chunks: Option<mpsc::SyncSender<Columns>>,
     chunker: Option<JoinHandle<Option<String>>>,
+    /// Columns the chunk thread has emptied, back for their entity's next rows. In a mutex
+    /// only because the recorder must be `Sync`; reached through `&mut`.
+    emptied: std::sync::Mutex<mpsc::Receiver<Columns>>,
+    /// Per entity: emptied columns waiting to be filled.
+    spare: Vec<Option<Columns>>,
+    /// Column sets with the chunk thread (sent and not back yet).
+    out: usize,
 }
 
 impl RrdStream {
     pub fn new(rec: RecordingStream) -> Self {
         let (chunks, queue) = mpsc::sync_channel::<Columns>(QUEUED_CHUNKS);
+        let (done, emptied) = mpsc::channel();
         let sdk = rec.clone();
         // without the thread, chunks are built on the caller's thread
         let chunker = std::thread::Builder::new()
             .name("rrd chunks".into())
             .spawn(move || {
                 let mut error = None;
-                for columns in queue {
+                for mut columns in queue {
                     match columns.build() {
                         Ok(chunk) => sdk.send_chunk(chunk),
                         Err(e) => {
                             error.get_or_insert(e);
                         }
                     }
+                    // the stream may be flushing already
+                    let _ = done.send(columns);
                 }
                 error
             })
@@ -253,6 +298,29 @@ impl RrdStream {
             error: None,
             chunks: chunker.as_ref().map(|_| chunks),
             chunker,
+            emptied: std::sync::Mutex::new(emptied),
+            spare: Vec::new(),
+            out: 0,
+        }
+    }
+
+    /// Keeps the columns the chunk thread has emptied so far (with `wait`, all of them: waits
+    /// until every set sent is back).
+    fn take_emptied(&mut self, wait: bool) {
+        let emptied = self.emptied.get_mut().unwrap_or_else(|e| e.into_inner());
+        while self.out > 0 {
+            let next = if wait {
+                emptied.recv().ok()
+            } else {
+                emptied.try_recv().ok()
+            };
+            let Some(c) = next else { break };
+            self.out -= 1;
+            let k = c.entity;
+            if self.spare.len() <= k {
+                self.spare.resize_with(k + 1, || None);
+            }
+            self.spare[k] = Some(c);
         }
     }
 
@@ -269,14 +337,19 @@ impl RrdStream {
         let k = match self.index.get(path) {
             Some(&k) => k,
             None => {
-                self.index.insert(path.to_string(), self.pending.len());
-                self.pending.push(Columns::new(EntityPath::from(path)));
-                self.pending.len() - 1
+                let k = self.pending.len();
+                self.index.insert(path.to_string(), k);
+                self.pending.push(Columns::new(k, EntityPath::from(path)));
+                k
             }
         };
         let full = {
             let p = &self.pending[k];
-            p.times.len() >= CHUNK_ROWS || p.bytes >= CHUNK_BYTES
+            p.times.len() >= CHUNK_ROWS
+                || p.bytes >= CHUNK_BYTES
+                || p.times
+                    .first()
+                    .is_some_and(|&t0| self.time - t0 > chunk_span_ns())
         };
         if full && let Err(e) = self.send(k) {
             self.error.get_or_insert(e);
@@ -322,19 +395,28 @@ impl RrdStream {
 
     /// Sends the rows gathered for entity `k` (to the chunk thread while it runs).
     fn send(&mut self, k: usize) -> Result<(), String> {
-        let p = &mut self.pending[k];
-        if p.times.is_empty() {
+        if self.pending[k].times.is_empty() {
             return Ok(());
         }
-        let columns = std::mem::replace(p, Columns::new(p.path.clone()));
-        let columns = match &self.chunks {
-            Some(chunks) => match chunks.send(columns) {
-                Ok(()) => return Ok(()),
-                Err(mpsc::SendError(columns)) => columns,
-            },
-            None => columns,
+        self.take_emptied(false);
+        let p = &mut self.pending[k];
+        let next = match self.spare.get_mut(k).and_then(Option::take) {
+            Some(spare) => spare,
+            None => Columns::new(k, p.path.clone()),
         };
-        self.rec.send_chunk(columns.build()?);
+        let mut columns = std::mem::replace(p, next);
+        if let Some(chunks) = &self.chunks {
+            match chunks.send(columns) {
+                Ok(()) => {
+                    self.out += 1;
+                    return Ok(());
+                }
+                Err(mpsc::SendError(back)) => columns = back,
+            }
+        }
+        let chunk = columns.build();
+        self.pending[k] = columns;
+        self.rec.send_chunk(chunk?);
         Ok(())
     }
 
@@ -365,6 +447,11 @@ impl RrdStream {
         }
         first.map_or(Ok(()), Err)
     }
+}
+
+/// [`CHUNK_SPAN_S`] in ns.
+fn chunk_span_ns() -> i64 {
+    sim_time_nanos(CHUNK_SPAN_S)
 }
 
 /// Simulated time `secs` on the `sim_time` timeline (ns), as `RecordingStream::set_duration_secs`
@@ -517,7 +604,8 @@ mod tests {
         let mut s = RrdStream::new(rec);
         let n = CHUNK_ROWS + 10;
         for k in 0..n {
-            s.set_duration_secs("sim_time", k as f64 * 0.1);
+            // well within CHUNK_SPAN_S
+            s.set_duration_secs("sim_time", k as f64 * 0.005);
             s.log("a", &rerun::Scalars::single(k as f64)).unwrap();
             if k % 2 == 0 {
                 s.log("b", &rerun::Points3D::new([[k as f32, 0.0, 0.0]]))
@@ -535,6 +623,87 @@ mod tests {
                 ("/b".to_string(), n.div_ceil(2), t),
             ]
         );
+    }
+
+    /// Later chunks of an entity fill the columns its earlier chunks emptied: each chunk holds
+    /// its own rows' values only, a component no row of a chunk has is not in it, and a
+    /// component may change type from one chunk to the next.
+    #[test]
+    fn later_chunks_reuse_the_emptied_columns_and_hold_only_their_rows() {
+        use rerun::components::{Radius, Scalar};
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("test").memory().unwrap();
+        let mut s = RrdStream::new(rec);
+        let scalars = rerun::Scalars::descriptor_scalars();
+        let radii = rerun::Points3D::descriptor_radii();
+        let chunks = 4;
+        for k in 0..chunks * CHUNK_ROWS {
+            let c = k / CHUNK_ROWS;
+            if k % CHUNK_ROWS == 0 {
+                // the chunk before last is back: this row's send hands its columns over
+                s.take_emptied(true);
+            }
+            s.set_duration_secs("sim_time", k as f64 * 0.001);
+            let row = s.row("x");
+            // chunk 0: scalars and radii; chunk 1: scalars only; chunk 2: the radii
+            // descriptor with scalar values; chunk 3: both again, three values a row
+            match c {
+                0 => row
+                    .with(scalars.clone(), [Scalar::from(k as f64)])
+                    .with(radii.clone(), [Radius::from(k as f32)]),
+                1 => row.with(scalars.clone(), [Scalar::from(k as f64)]),
+                2 => row.with(radii.clone(), [Scalar::from(-(k as f64))]),
+                _ => row
+                    .with(scalars.clone(), [Scalar::from(k as f64); 3])
+                    .with(radii.clone(), [Radius::from(k as f32); 3]),
+            };
+        }
+        s.flush_blocking().unwrap();
+        let msgs = storage.take();
+        let got = entity_chunks(&msgs, "/x");
+        assert_eq!(got.len(), chunks);
+        let values = |chunk: &Chunk, d: &ComponentDescriptor| {
+            chunk.components().get_array(d.component).map(|a| {
+                let inner = a.values();
+                (a.len(), inner.len(), inner.data_type().clone())
+            })
+        };
+        let (rows, n) = (CHUNK_ROWS, CHUNK_ROWS);
+        let f64s = arrow::datatypes::DataType::Float64;
+        let f32s = arrow::datatypes::DataType::Float32;
+        assert_eq!(values(&got[0], &scalars), Some((rows, n, f64s.clone())));
+        assert_eq!(values(&got[0], &radii), Some((rows, n, f32s.clone())));
+        assert_eq!(values(&got[1], &scalars), Some((rows, n, f64s.clone())));
+        assert_eq!(values(&got[1], &radii), None);
+        assert_eq!(values(&got[2], &scalars), None);
+        assert_eq!(values(&got[2], &radii), Some((rows, n, f64s.clone())));
+        assert_eq!(values(&got[3], &scalars), Some((rows, 3 * n, f64s)));
+        assert_eq!(values(&got[3], &radii), Some((rows, 3 * n, f32s)));
+        // the last chunk's first scalar is its first row's, not a left-over
+        let first = got[3]
+            .components()
+            .get_array(scalars.component)
+            .unwrap()
+            .value(0);
+        let first = first
+            .as_any()
+            .downcast_ref::<arrow::array::Float64Array>()
+            .unwrap();
+        assert_eq!(first.value(0), (3 * CHUNK_ROWS) as f64);
+    }
+
+    #[test]
+    fn a_chunk_spans_at_most_chunk_span_s_of_sim_time() {
+        let (rec, storage) = rerun::RecordingStreamBuilder::new("test").memory().unwrap();
+        let mut s = RrdStream::new(rec);
+        let n = 100;
+        for k in 0..n {
+            s.set_duration_secs("sim_time", k as f64 * CHUNK_SPAN_S / 30.0);
+            s.log("a", &rerun::Scalars::single(k as f64)).unwrap();
+        }
+        s.flush_blocking().unwrap();
+        let rows: Vec<usize> = chunks(&storage.take()).iter().map(|c| c.1).collect();
+        // a row more than the span after the chunk's first starts the next chunk
+        assert_eq!(rows, [31, 31, 31, 7]);
     }
 
     #[test]

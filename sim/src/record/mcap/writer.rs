@@ -12,8 +12,10 @@
 //!
 //! Threads: the caller only encodes messages (CDR) into a batch; compression, checksums and
 //! file writes happen on a writer thread of the recorder, which takes the batches in order
-//! (at most [`QUEUED_BATCHES`] waiting, so memory stays bounded). The file is the same as if
-//! written on the caller's thread. A write error is reported by the next
+//! (at most [`QUEUED_BATCHES`] waiting, so memory stays bounded). A large message (a camera
+//! image) is better handed over whole ([`McapRecorder::write_owned`]): the writer thread
+//! encodes it, so the caller does not copy its payload. The file is the same as if written on
+//! the caller's thread. A write error is reported by the next
 //! [`McapRecorder::flush`] or by [`McapRecorder::finish`]; nothing is written after it.
 
 use super::cdr;
@@ -107,6 +109,12 @@ enum Op {
         log_time: u64,
         end: usize,
     },
+    /// A message the writer thread encodes ([`McapRecorder::write_owned`]).
+    Owned {
+        channel: u16,
+        log_time: u64,
+        msg: Box<dyn Encode>,
+    },
     Schema {
         name: &'static str,
         definition: &'static str,
@@ -127,6 +135,18 @@ enum Op {
     /// Stop as a dying process would: no summary, buffered bytes lost (tests).
     #[cfg_attr(not(test), allow(dead_code))]
     Abandon,
+}
+
+/// A message to encode later, on the writer thread.
+trait Encode: Send + Sync {
+    /// Its CDR payload, into `out` (cleared first).
+    fn encode_into(&self, out: &mut Vec<u8>);
+}
+
+impl<T: RosMessage + Send + Sync> Encode for T {
+    fn encode_into(&self, out: &mut Vec<u8>) {
+        cdr::encode_into(out, self);
+    }
 }
 
 impl McapRecorder {
@@ -299,6 +319,26 @@ impl McapRecorder {
         Ok(())
     }
 
+    /// [`McapRecorder::write`] for a message taken whole: it is encoded on the writer thread,
+    /// so a large payload (an image) is neither copied nor encoded by the caller. The file is
+    /// the same as with [`McapRecorder::write`].
+    pub fn write_owned<T: RosMessage + Send + Sync + 'static>(
+        &mut self,
+        channel: Channel<T>,
+        log_time_ns: u64,
+        msg: T,
+    ) -> anyhow::Result<()> {
+        self.batch.ops.push(Op::Owned {
+            channel: channel.id,
+            log_time: log_time_ns,
+            msg: Box::new(msg),
+        });
+        if self.batch.ops.len() >= BATCH_OPS {
+            self.send()?;
+        }
+        Ok(())
+    }
+
     /// Adds an attachment (e.g. the resolved scenario, `application/toml`), stamped with the
     /// latest log time written so far. Ends the current chunk.
     pub fn attach(&mut self, name: &str, media_type: &str, data: &[u8]) -> anyhow::Result<()> {
@@ -362,6 +402,7 @@ impl FileWriter {
         done: mpsc::Sender<Batch>,
     ) -> anyhow::Result<McapStats> {
         let mut error: Option<anyhow::Error> = None;
+        let mut payload = Vec::new();
         for mut batch in queue {
             let mut start = 0;
             for op in batch.ops.drain(..) {
@@ -375,6 +416,16 @@ impl FileWriter {
                         start = end;
                         if error.is_none() {
                             error = self.message(channel, log_time, data).err();
+                        }
+                    }
+                    Op::Owned {
+                        channel,
+                        log_time,
+                        msg,
+                    } => {
+                        if error.is_none() {
+                            msg.encode_into(&mut payload);
+                            error = self.message(channel, log_time, &payload).err();
                         }
                     }
                     Op::Abandon => {

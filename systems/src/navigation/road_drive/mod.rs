@@ -188,6 +188,12 @@ impl RoadNavigator {
         out
     }
 
+    /// The start edge of the current route (the first of [`RoadNavigator::route_edges`]),
+    /// without gathering the rest.
+    pub fn route_start_edge(&self) -> Option<EdgeId> {
+        self.route.as_ref().and(self.route_start).map(|(e, _)| e)
+    }
+
     /// The edges of the current route, the start edge first.
     pub fn route_edges(&self) -> Vec<EdgeId> {
         self.route_steps().into_iter().map(|(e, _)| e).collect()
