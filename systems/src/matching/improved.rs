@@ -28,7 +28,16 @@
 //!    corridor win.
 //! 6. **Final refinement**: the best screened candidates (no two alike), plus the best of up to
 //!    `extra_rotations` rotations not yet among them, are refined on the fine set and judged
-//!    again; the best wins.
+//!    again; the best wins. The reference surface between two samples of one wall is the
+//!    segment joining them ([`super::refine::Reference::line_at`]), and normals of sparsely
+//!    sampled walls come from a gate that widens with the sample spacing
+//!    ([`super::normals`]): otherwise far and grazing walls count only near their samples and
+//!    shifts that line the two scans' samples up win, 0.1–0.2 m along a corridor.
+//!
+//!    **Corridor line search**: where the refined translation is weakly constrained (a
+//!    corridor), the inlier count is scanned along the weak direction (±`weak_search`); its
+//!    best `weak_peaks` local maxima are refined again and judged, and the best judged answer
+//!    is kept.
 //!
 //!    **Rotation polish**: when the winner explains less than `polish_below` of the fine set
 //!    (little overlap, e.g. 30 steps apart), the wide starting gate lets the refinement pull the
@@ -100,6 +109,9 @@ pub struct ImprovedConfig {
     /// Half-length (m) and step (m) of that line search.
     pub weak_search: f32,
     pub weak_step: f32,
+    /// The best local maxima of the inlier count along that line (other than the refined
+    /// answer itself) that are refined again and judged.
+    pub weak_peaks: usize,
     /// Run the rotation polish when the winner's inlier fraction of the fine set is below this
     /// (0 disables it).
     pub polish_below: f32,
@@ -137,7 +149,8 @@ impl Default for ImprovedConfig {
             weak_ratio: 0.3,
             weak_search: 0.6,
             weak_step: 0.05,
-            polish_below: 0.35,
+            weak_peaks: 1,
+            polish_below: 0.5,
             polish_gate: 0.15,
             fallback_below: 0.2,
             fallback: DeParams {
@@ -257,6 +270,7 @@ impl ImprovedConfig {
             "1 ..= 65535",
         )?;
         count("improved.screened", self.screened, 10_000, "1 ..= 10000")?;
+        count("improved.weak_peaks", self.weak_peaks, 100, "1 ..= 100")?;
         count("improved.finalists", self.finalists, 10_000, "1 ..= 10000")?;
         if self.extra_rotations > 10_000 {
             return Err(MatchError::InvalidParameter {
@@ -332,6 +346,23 @@ fn pick_finalists(screened: &[(Vector, f64)], n: usize, extra_rotations: usize) 
     picked
 }
 
+/// Indices of the best `n` strict local maxima of `counts` (a maximum's right neighbour is
+/// lower, its left one not higher; `None` is outside the window), most inliers first, then
+/// nearest the middle; the middle itself (the refined answer) is left out.
+fn line_peaks(counts: &[Option<usize>], n: usize) -> Vec<i32> {
+    let mid = (counts.len() / 2) as i32;
+    let mut peaks: Vec<(usize, i32)> = (0..counts.len())
+        .filter_map(|i| {
+            let c = counts[i]?;
+            let left = i.checked_sub(1).and_then(|j| counts[j]).unwrap_or(0);
+            let right = counts.get(i + 1).copied().flatten().unwrap_or(0);
+            (i as i32 != mid && c >= left && c > right).then_some((c, i as i32))
+        })
+        .collect();
+    peaks.sort_by_key(|&(c, i)| (std::cmp::Reverse(c), (i - mid).abs()));
+    peaks.into_iter().take(n).map(|(_, i)| i).collect()
+}
+
 /// Runs the pipeline of the module docs. Points must be finite and both sets non-empty.
 pub(crate) fn match_improved(
     reference: &[[f32; 2]],
@@ -342,7 +373,9 @@ pub(crate) fn match_improved(
 ) -> Result<ImprovedOutcome, MatchError> {
     cfg.validate()?;
     bounds.validate()?;
-    let normal_gate = 0.5;
+    // normals from neighbours within 0.5 m, or within 3.5 point spacings up to 1.5 m where a
+    // wall is sampled sparsely (far away, grazing)
+    let (normal_gate, normal_max_gate) = (0.5, 1.5);
     // 1. subsampling
     let ref_fine = subsample(
         reference,
@@ -352,8 +385,8 @@ pub(crate) fn match_improved(
     let cur_fine = subsample(current, cfg.fine_spacing, cfg.fine_points);
     let cur_coarse = subsample(current, cfg.coarse_spacing, cfg.coarse_points);
     let ref_coarse = subsample(reference, cfg.coarse_spacing, cfg.coarse_points);
-    let ref_normals = estimate_normals(&ref_fine, normal_gate);
-    let cur_normals = estimate_normals(&cur_fine, normal_gate);
+    let ref_normals = estimate_normals(&ref_fine, normal_gate, normal_max_gate);
+    let cur_normals = estimate_normals(&cur_fine, normal_gate, normal_max_gate);
     // 2. reference model
     let score_grid = ScoreGrid::build(&ref_fine, cfg.coarse_cell, cfg.coarse_radius, 2);
     let nearest = NearestGrid::build(&ref_fine, cfg.fine_cell, cfg.gate, 3);
@@ -459,29 +492,25 @@ pub(crate) fn match_improved(
         // ends that fix the position along it, so search that line with the judge and refine
         // again from the best point
         if refined.weak_ratio < cfg.weak_ratio {
-            let d = refined.weak_direction;
+            let (d, origin) = (refined.weak_direction, r);
             let steps = (cfg.weak_search / cfg.weak_step).round() as i32;
-            let mut best = (judge.inliers(&cur_fine, &r), 0i32);
-            for k in (-steps..=steps).filter(|&k| k != 0) {
+            let at = |k: i32| {
                 let o = k as f64 * cfg.weak_step as f64;
-                let t = [r[0] + o * d[0], r[1] + o * d[1], r[2]];
-                if !bounds.contains(&t) {
-                    continue;
-                }
-                let n = judge.inliers(&cur_fine, &t);
-                // more inliers wins; on ties the smaller offset
-                if n > best.0 || (n == best.0 && k.abs() < best.1.abs()) {
-                    best = (n, k);
-                }
-            }
-            if best.1 != 0 {
-                let o = best.1 as f64 * cfg.weak_step as f64;
-                let t = [r[0] + o * d[0], r[1] + o * d[1], r[2]];
+                [origin[0] + o * d[0], origin[1] + o * d[1], origin[2]]
+            };
+            let counts: Vec<Option<usize>> = (-steps..=steps)
+                .map(|k| {
+                    let t = at(k);
+                    bounds.contains(&t).then(|| judge.inliers(&cur_fine, &t))
+                })
+                .collect();
+            let mut best_score = judge.score(&cur_fine, &ref_fine, &r).0;
+            for k in line_peaks(&counts, cfg.weak_peaks) {
+                let t = at(k - steps);
                 let again = keep_inside(refine(&judge.model, &cur_fine, t, &full).x, t);
-                if judge.score(&cur_fine, &ref_fine, &again).0
-                    > judge.score(&cur_fine, &ref_fine, &r).0
-                {
-                    r = again;
+                let score = judge.score(&cur_fine, &ref_fine, &again).0;
+                if score > best_score {
+                    (best_score, r) = (score, again);
                 }
             }
         }
@@ -538,4 +567,50 @@ pub(crate) fn match_improved(
         inliers: inliers as f64 / n_fine,
         evaluations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::line_peaks;
+
+    #[test]
+    fn line_peaks_are_the_best_local_maxima_other_than_the_middle() {
+        // middle index 4 (the refined answer) is a maximum but left out; 9 at index 7 beats
+        // the plateau 7, 7 at 1–2 (its right end is the maximum); None is outside the window
+        let counts = [
+            Some(3),
+            Some(7),
+            Some(7),
+            Some(2),
+            Some(10),
+            Some(4),
+            Some(5),
+            Some(9),
+            None,
+        ];
+        assert_eq!(line_peaks(&counts, 5), vec![7, 2]);
+        assert_eq!(line_peaks(&counts, 1), vec![7]);
+        // equal peaks: the nearer to the middle first
+        let even = [
+            Some(6),
+            Some(1),
+            Some(1),
+            Some(1),
+            Some(0),
+            Some(1),
+            Some(6),
+        ];
+        assert_eq!(line_peaks(&even, 2), vec![0, 6]);
+        let near = [
+            Some(6),
+            Some(1),
+            Some(6),
+            Some(1),
+            Some(0),
+            Some(1),
+            Some(1),
+        ];
+        assert_eq!(line_peaks(&near, 1), vec![2]);
+        assert!(line_peaks(&[None, Some(3), None], 2).is_empty());
+    }
 }

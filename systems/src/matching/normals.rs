@@ -12,6 +12,8 @@
 
 /// Beams on each side of a point used for its normal.
 const HALF_WINDOW: usize = 3;
+/// Adaptive gate of [`estimate_normals`] in units of the local point spacing.
+const SPACING_GATE: f32 = 3.5;
 /// Smallest number of points (the centre included) for a normal.
 const MIN_POINTS: usize = 4;
 /// Largest ratio of the small to the large eigenvalue of the neighbourhood covariance: the
@@ -20,12 +22,33 @@ const MAX_FLATNESS: f32 = 0.1;
 
 /// The unit normal of every point (pointing towards the sensor at the origin), or `None` where
 /// the neighbourhood is too small or not line-like. `gate` is the largest neighbour distance (m).
-pub(crate) fn estimate_normals(points: &[[f32; 2]], gate: f32) -> Vec<Option<[f32; 2]>> {
+///
+/// Where `max_gate` exceeds `gate`, a point's gate widens, up to `max_gate`, to
+/// [`SPACING_GATE`] × the point's spacing from its nearer scan neighbour: a wall seen at a
+/// grazing angle or far away is sampled sparsely but evenly, a depth jump is a gap much wider
+/// than the spacing on its either side.
+pub(crate) fn estimate_normals(
+    points: &[[f32; 2]],
+    gate: f32,
+    max_gate: f32,
+) -> Vec<Option<[f32; 2]>> {
     let n = points.len();
-    let g2 = gate * gate;
+    let gap2 = |i: usize, j: usize| {
+        let (a, b) = (points[i], points[j]);
+        (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
+    };
     let mut out = Vec::with_capacity(n);
     for k in 0..n {
         let p = points[k];
+        let mut g2 = gate * gate;
+        if max_gate > gate {
+            let local2 = match (k.checked_sub(1), (k + 1 < n).then_some(k + 1)) {
+                (Some(i), Some(j)) => gap2(k, i).min(gap2(k, j)),
+                (Some(i), None) | (None, Some(i)) => gap2(k, i),
+                (None, None) => 0.0,
+            };
+            g2 = g2.max((SPACING_GATE * SPACING_GATE * local2).min(max_gate * max_gate));
+        }
         let (lo, hi) = (k.saturating_sub(HALF_WINDOW), (k + HALF_WINDOW + 1).min(n));
         let (mut cnt, mut sx, mut sy, mut sxx, mut sxy, mut syy) =
             (0usize, 0f32, 0f32, 0f32, 0f32, 0f32);
@@ -84,27 +107,55 @@ mod tests {
     fn wall_normals_face_the_sensor() {
         // a wall x = 2 seen from the origin, and a corner-free wall y = −1
         let wall: Vec<[f32; 2]> = (0..20).map(|k| [2.0, -1.0 + 0.1 * k as f32]).collect();
-        let nr = estimate_normals(&wall, 0.5);
+        let nr = estimate_normals(&wall, 0.5, 0.5);
         for n in nr.iter().flatten() {
             assert!((n[0] + 1.0).abs() < 1e-4 && n[1].abs() < 1e-3, "{n:?}");
         }
         assert!(nr.iter().all(|n| n.is_some()));
         let floor: Vec<[f32; 2]> = (0..20).map(|k| [-1.0 + 0.1 * k as f32, -1.0]).collect();
-        for n in estimate_normals(&floor, 0.5).iter().flatten() {
+        for n in estimate_normals(&floor, 0.5, 0.5).iter().flatten() {
             assert!(n[0].abs() < 1e-3 && (n[1] - 1.0).abs() < 1e-4, "{n:?}");
+        }
+    }
+
+    #[test]
+    fn the_gate_widens_with_even_sparse_sampling_but_not_across_a_jump() {
+        // a wall sampled every 0.3 m: no normals with a fixed 0.5 m gate, all with the
+        // adaptive one
+        let wall: Vec<[f32; 2]> = (0..12).map(|k| [-1.5 + 0.3 * k as f32, 4.0]).collect();
+        assert!(
+            estimate_normals(&wall, 0.5, 0.5)
+                .iter()
+                .all(|n| n.is_none())
+        );
+        let adaptive = estimate_normals(&wall, 0.5, 1.5);
+        for n in &adaptive {
+            let n = n.expect("a normal on every sample");
+            assert!(n[0].abs() < 1e-3 && (n[1] + 1.0).abs() < 1e-4, "{n:?}");
+        }
+        // densely sampled wall, a jump of 1 m, another dense wall further back: the points at
+        // the jump keep neighbours of their own wall only (gate 3.5 × 5 cm, not 1 m)
+        let mut jump: Vec<[f32; 2]> = (0..10).map(|k| [0.05 * k as f32, 2.0]).collect();
+        jump.extend((0..10).map(|k| [1.45 + 0.05 * k as f32, 3.0]));
+        for n in estimate_normals(&jump, 0.5, 1.5).iter().flatten() {
+            assert!(n[0].abs() < 1e-3, "{n:?}");
         }
     }
 
     #[test]
     fn isolated_or_scattered_points_have_no_normal() {
         let sparse: Vec<[f32; 2]> = (0..10).map(|k| [k as f32, 1.0]).collect();
-        assert!(estimate_normals(&sparse, 0.5).iter().all(|n| n.is_none()));
+        assert!(
+            estimate_normals(&sparse, 0.5, 0.5)
+                .iter()
+                .all(|n| n.is_none())
+        );
         // a tight zig-zag is not a line
         let zig: Vec<[f32; 2]> = (0..10)
             .map(|k| [1.0 + 0.05 * k as f32, if k % 2 == 0 { 0.0 } else { 0.1 }])
             .collect();
         assert!(
-            estimate_normals(&zig, 0.5)[3..7]
+            estimate_normals(&zig, 0.5, 0.5)[3..7]
                 .iter()
                 .all(|n| n.is_none())
         );

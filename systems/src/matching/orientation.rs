@@ -146,11 +146,11 @@ mod tests {
     #[test]
     fn the_best_hypothesis_is_the_rotation() {
         let reference = shape(0.0);
-        let h_ref = orientation_histogram(&reference, &estimate_normals(&reference, 0.3));
+        let h_ref = orientation_histogram(&reference, &estimate_normals(&reference, 0.3, 0.3));
         for deg in [-170.0f32, -57.0, 0.0, 33.3, 120.0, 179.0] {
             // the current scan is the reference seen rotated by −ω, so ω maps it back
             let current = shape(-deg.to_radians());
-            let h_cur = orientation_histogram(&current, &estimate_normals(&current, 0.3));
+            let h_cur = orientation_histogram(&current, &estimate_normals(&current, 0.3, 0.3));
             let hyp = rotation_hypotheses(&h_ref, &h_cur, 4, std::f64::consts::PI);
             let err = crate::core::wrap_angle(hyp[0].0 - deg.to_radians() as f64).to_degrees();
             assert!(err.abs() < 0.6, "{deg}: {hyp:?}");
@@ -161,8 +161,8 @@ mod tests {
     fn window_limits_hypotheses() {
         let reference = shape(0.0);
         let current = shape(-2.0);
-        let h_ref = orientation_histogram(&reference, &estimate_normals(&reference, 0.3));
-        let h_cur = orientation_histogram(&current, &estimate_normals(&current, 0.3));
+        let h_ref = orientation_histogram(&reference, &estimate_normals(&reference, 0.3, 0.3));
+        let h_cur = orientation_histogram(&current, &estimate_normals(&current, 0.3, 0.3));
         let hyp = rotation_hypotheses(&h_ref, &h_cur, 8, 0.5);
         assert!(hyp.iter().all(|h| h.0.abs() <= 0.51));
     }

@@ -8,9 +8,10 @@
 //! up in the nearest-index grid ([`super::ref_grid`]) and checks the two beams on either side of
 //! it (the grid stores the point nearest to the cell centre, its scan neighbours may be nearer to
 //! the query), then minimises `Σ w · (nᵀ(R b + t − a))²` over `(t_x, t_y, θ)` with the
-//! reference normal `n`. Where the reference has no normal, or where the moved point lies beyond
-//! the end of the reference surface (its offset along the surface exceeds `end_tangent`, e.g.
-//! past a door jamb), the residual is point-to-point instead: point-to-line alone would let a
+//! reference normal `n`. Between two samples of one surface the line is the segment joining
+//! them ([`Reference::line_at`]). Where the reference has no normal, or where the moved point
+//! lies beyond the end of the reference surface (its offset along the surface exceeds
+//! `end_tangent`, e.g. past a door jamb), the residual is point-to-point instead: point-to-line alone would let a
 //! scan slide along a corridor, since only the ends of walls say where along it the robot is.
 //! Pairs farther apart than a gate are dropped; the gate shrinks geometrically from `gate_start`
 //! to `gate_end`, and a Huber weight tempers the remaining outliers. A tiny Levenberg damping
@@ -56,22 +57,73 @@ impl Reference<'_> {
         Some(best)
     }
 
-    /// Distance from `q` to the reference surface at its nearest point: along the normal where
-    /// there is one and `q` is not beyond the surface's end (offset along it ≤ `end_tangent`),
-    /// else point to point. `None` if no reference point is near.
+    /// The reference surface at `q`, nearest point `a`: `Some((anchor, normal))` where `q` lies
+    /// on a line of the reference (within `end_tangent` along it of point `a`, or over the
+    /// segment from `a` to its scan neighbour on the same surface), `None` where it lies beyond
+    /// the end of a surface or `a` has no normal (then point to point).
+    ///
+    /// The segments matter where the reference samples a wall sparsely (far away or at a grazing
+    /// angle): with `a`'s tangent alone, a point between two samples 0.2 m apart would count as
+    /// off the surface, and the judgement and the refinement would favour shifts that line the
+    /// samples of the two scans up, 0.1–0.2 m along a corridor from the truth.
+    #[inline]
+    pub fn line_at(&self, q: [f32; 2], a: usize, end_tangent: f32) -> Option<([f32; 2], [f32; 2])> {
+        let n = self.normals[a]?;
+        let p = self.points[a];
+        let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+        let along = dx * n[1] - dy * n[0];
+        if along.abs() <= end_tangent {
+            return Some((p, n));
+        }
+        // the scan neighbour on the side of q, if it continues the same surface
+        for b in [a.checked_sub(1), Some(a + 1)].into_iter().flatten() {
+            let (Some(&pb), Some(Some(nb))) = (self.points.get(b), self.normals.get(b)) else {
+                continue;
+            };
+            let (ex, ey) = (pb[0] - p[0], pb[1] - p[1]);
+            let len2 = ex * ex + ey * ey;
+            let across = ex * n[0] + ey * n[1];
+            // near enough, facing the same way, and along a's line (not a step behind it)
+            let continues = len2 > 0.0
+                && len2 <= SEGMENT_GAP * SEGMENT_GAP
+                && n[0] * nb[0] + n[1] * nb[1] >= SEGMENT_COS
+                && across * across <= SEGMENT_SLOPE * SEGMENT_SLOPE * len2;
+            if !continues {
+                continue;
+            }
+            // projection of q on the segment, in units of its length
+            let u = (dx * ex + dy * ey) / len2;
+            let len = len2.sqrt();
+            if u > 0.0 && u * len <= len + end_tangent {
+                let inv = 1.0 / len;
+                let mut m = [-ey * inv, ex * inv];
+                if m[0] * n[0] + m[1] * n[1] < 0.0 {
+                    m = [-m[0], -m[1]];
+                }
+                return Some((p, m));
+            }
+        }
+        None
+    }
+
+    /// Distance from `q` to the reference surface: point to line where [`Self::line_at`] finds
+    /// a line, else point to point. `None` if no reference point is near.
     #[inline]
     pub fn distance(&self, q: [f32; 2], end_tangent: f32) -> Option<f32> {
         let (a, d2) = self.nearest(q)?;
-        let p = self.points[a];
-        let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
-        Some(match self.normals[a] {
-            Some(n) if (dx * n[1] - dy * n[0]).abs() <= end_tangent => {
-                (dx * n[0] + dy * n[1]).abs()
-            }
-            _ => d2.sqrt(),
+        Some(match self.line_at(q, a, end_tangent) {
+            Some((p, n)) => ((q[0] - p[0]) * n[0] + (q[1] - p[1]) * n[1]).abs(),
+            None => d2.sqrt(),
         })
     }
 }
+
+/// Longest gap (m) between two scan neighbours of the reference that [`Reference::line_at`]
+/// bridges as one surface, the smallest cosine between their normals (20°) and the largest
+/// slope of the segment across the first one's line.
+const SEGMENT_GAP: f32 = 0.5;
+const SEGMENT_COS: f32 = 0.94;
+const SEGMENT_SLOPE: f32 = 0.25;
 
 /// The result of [`refine`].
 #[derive(Clone, Copy, Debug)]
@@ -94,7 +146,6 @@ pub(crate) fn refine(
     let mut x = start;
     let mut weak = ([1.0, 0.0], 1.0);
     let mut gate = params.gate_start.max(params.gate_end);
-    let e2 = params.end_tangent * params.end_tangent;
     for _ in 0..params.iterations.max(1) {
         let g2 = gate * gate;
         let (s, c) = x[2].sin_cos();
@@ -120,23 +171,20 @@ pub(crate) fn refine(
             if d2 > g2 {
                 continue;
             }
-            let p = reference.points[a];
-            let (dx, dy) = ((q[0] - p[0]) as f64, (q[1] - p[1]) as f64);
             // ∂q/∂θ = (−ry, rx)
             let (jx, jy) = (-ry as f64, rx as f64);
             used += 1;
             // point-to-line unless the pair lies off the end of the reference surface
-            let line = reference.normals[a].filter(|n| {
-                let along = (dx * n[1] as f64 - dy * n[0] as f64).powi(2);
-                along <= e2 as f64
-            });
-            match line {
-                Some(n) => {
+            match reference.line_at(q, a, params.end_tangent) {
+                Some((p, n)) => {
+                    let (dx, dy) = ((q[0] - p[0]) as f64, (q[1] - p[1]) as f64);
                     let (nx, ny) = (n[0] as f64, n[1] as f64);
                     let r = nx * dx + ny * dy;
                     add([nx, ny, nx * jx + ny * jy], r, huber(r, params.huber));
                 }
                 None => {
+                    let p = reference.points[a];
+                    let (dx, dy) = ((q[0] - p[0]) as f64, (q[1] - p[1]) as f64);
                     let w = huber((dx * dx + dy * dy).sqrt(), params.huber);
                     add([1.0, 0.0, jx], dx, w);
                     add([0.0, 1.0, jy], dy, w);
@@ -236,7 +284,7 @@ mod tests {
         for k in 0..30 {
             pts.push([0.5 + 0.01 * k as f32, -1.0]);
         }
-        let normals = estimate_normals(&pts, 0.3);
+        let normals = estimate_normals(&pts, 0.3, 0.3);
         let grid = NearestGrid::build(&pts, 0.1, 0.4, 3);
         let reference = Reference {
             points: &pts,
@@ -264,6 +312,36 @@ mod tests {
         assert!((x[0] - truth[0]).abs() < 2e-3, "{x:?}");
         assert!((x[1] - truth[1]).abs() < 2e-3, "{x:?}");
         assert!((x[2] - truth[2]).abs() < 1e-3, "{x:?}");
+    }
+
+    #[test]
+    fn a_sparsely_sampled_wall_is_a_surface_between_its_samples() {
+        // a wall y = 3 sampled every 0.3 m (far away or at a grazing angle), then a step back
+        // to y = 3.4 (a door recess) and a wall at right angles
+        let mut pts: Vec<[f32; 2]> = (0..10).map(|k| [0.3 * k as f32, 3.0]).collect();
+        pts.extend((0..5).map(|k| [3.0 + 0.3 * k as f32, 3.4]));
+        let normals = estimate_normals(&pts, 0.5, 1.5);
+        assert!(normals.iter().all(|n| n.is_some()), "{normals:?}");
+        let grid = NearestGrid::build(&pts, 0.1, 0.5, 3);
+        let reference = Reference {
+            points: &pts,
+            normals: &normals,
+            grid: &grid,
+        };
+        // between two samples, 1 cm off the wall: 1 cm, not the 15 cm to the nearer sample
+        let d = reference.distance([1.05, 2.99], 0.06).unwrap();
+        assert!((d - 0.01).abs() < 1e-3, "{d}");
+        // the gap from the wall to the recess is not bridged: point to point there
+        let q = [2.85, 3.19];
+        let d = reference.distance(q, 0.06).unwrap();
+        let nearest = pts
+            .iter()
+            .map(|p| (p[0] - q[0]).hypot(p[1] - q[1]))
+            .fold(f32::INFINITY, f32::min);
+        assert!((d - nearest).abs() < 1e-5, "{d} vs {nearest}");
+        // past the wall's last sample by more than end_tangent: point to point
+        let d = reference.distance([-0.2, 3.0], 0.06).unwrap();
+        assert!((d - 0.2).abs() < 1e-5, "{d}");
     }
 
     #[test]
