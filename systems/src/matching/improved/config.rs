@@ -36,8 +36,15 @@ pub struct ImprovedConfig {
     pub final_iterations: usize,
     /// Correspondence gate at the start of refinement (m); it shrinks to `2 · inlier_distance`.
     pub gate: f32,
-    /// A current point is an inlier if it is within this of the reference surface (m).
+    /// A current point is an inlier if it is within this of the reference surface (m); also the
+    /// Huber threshold of the search's refinements.
     pub inlier_distance: f32,
+    /// Huber threshold (m) of the winner's last, precise refinement (which starts with a gate
+    /// of twice this); its result is kept if it moves the answer less than `precise_reach` (m)
+    /// and `precise_reach_deg`.
+    pub precise_distance: f32,
+    pub precise_reach: f32,
+    pub precise_reach_deg: f32,
     /// A point more than this in front of the other scan's reading is a free-space violation (m).
     pub violation_margin: f32,
     /// Weight of a violation against an inlier in the judgement.
@@ -84,7 +91,10 @@ impl Default for ImprovedConfig {
             screen_iterations: 6,
             final_iterations: 15,
             gate: 0.5,
-            inlier_distance: 0.05,
+            inlier_distance: 0.08,
+            precise_distance: 0.05,
+            precise_reach: 0.05,
+            precise_reach_deg: 1.0,
             violation_margin: 0.2,
             violation_weight: 8.0,
             blob_extent: 0.7,
@@ -137,6 +147,9 @@ impl ImprovedConfig {
         pos("improved.fine_spacing", self.fine_spacing)?;
         pos("improved.gate", self.gate)?;
         pos("improved.inlier_distance", self.inlier_distance)?;
+        pos("improved.precise_distance", self.precise_distance)?;
+        pos("improved.precise_reach", self.precise_reach)?;
+        pos("improved.precise_reach_deg", self.precise_reach_deg)?;
         pos("improved.violation_margin", self.violation_margin)?;
         pos("improved.weak_search", self.weak_search)?;
         pos("improved.weak_step", self.weak_step)?;

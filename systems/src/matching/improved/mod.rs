@@ -48,6 +48,12 @@
 //!    of the fine set (few normals, e.g. unordered points, or heavy clutter), a DE run on the
 //!    score grid, seeded with the candidates, searches the whole window; its best member is
 //!    refined and judged like the others.
+//! 8. **Precise refinement**: the search refines with a Huber threshold of `inlier_distance`
+//!    (8 cm), which keeps low-overlap pairs in the right basin (λ 98.2 → 98.8 % over eight
+//!    seeds of the 460-pair protocol) but averages in points a few centimetres off. The winner
+//!    is refined once more with `precise_distance` (5 cm) from a narrow gate and kept if it
+//!    stays within `precise_reach`: consecutive scans' alignments are as precise as with 5 cm
+//!    throughout (maze-slam's DE scan-to-scan RPE 3.6 mm against 4.4 mm without this step).
 //!
 //! Everything is deterministic: no wall clock, no thread-count dependence, ties broken by order.
 
@@ -323,6 +329,24 @@ pub(crate) fn match_improved(
             best = Some(c);
         }
     }
+    // 8. precise refinement of the winner
+    if let Some(b) = best {
+        let precise = RefineParams {
+            iterations: cfg.final_iterations,
+            gate_start: 2.0 * cfg.precise_distance,
+            gate_end: 2.0 * cfg.precise_distance,
+            huber: cfg.precise_distance,
+            end_tangent: 1.2 * cfg.precise_distance,
+        };
+        let r = keep_inside(refine(&judge.model, &cur_fine, b.0, &precise).x, b.0);
+        evaluations += cfg.final_iterations as u64 + 1;
+        let near = (r[0] - b.0[0]).hypot(r[1] - b.0[1]) < cfg.precise_reach as f64
+            && wrap_angle(r[2] - b.0[2]).abs() < (cfg.precise_reach_deg as f64).to_radians();
+        if near {
+            let (score, inl) = judge.score(&cur_fine, &ref_fine, &r);
+            best = Some((r, score, inl));
+        }
+    }
     let (transform, _, inliers) = best.unwrap_or(([0.0; 3], 0.0, 0));
     Ok(ImprovedOutcome {
         transform: [transform[0], transform[1], wrap_angle(transform[2])],
@@ -333,7 +357,34 @@ pub(crate) fn match_improved(
 
 #[cfg(test)]
 mod tests {
-    use super::line_peaks;
+    use super::{ImprovedConfig, line_peaks};
+    use crate::matching::error::MatchError;
+
+    #[test]
+    fn a_bad_precise_refinement_setting_names_its_field() {
+        for (field, cfg) in [
+            (
+                "improved.precise_distance",
+                ImprovedConfig {
+                    precise_distance: 0.0,
+                    ..ImprovedConfig::default()
+                },
+            ),
+            (
+                "improved.precise_reach_deg",
+                ImprovedConfig {
+                    precise_reach_deg: f32::NAN,
+                    ..ImprovedConfig::default()
+                },
+            ),
+        ] {
+            match cfg.validate() {
+                Err(MatchError::InvalidParameter { name, .. }) => assert_eq!(name, field),
+                other => panic!("{field}: {other:?}"),
+            }
+        }
+        assert!(ImprovedConfig::default().validate().is_ok());
+    }
 
     #[test]
     fn line_peaks_are_the_best_local_maxima_other_than_the_middle() {
