@@ -11,8 +11,9 @@
 //! reference normal `n`. Between two samples of one surface the line is the segment joining
 //! them ([`Reference::line_at`]). Where the reference has no normal, or where the moved point
 //! lies beyond the end of the reference surface (its offset along the surface exceeds
-//! `end_tangent`, e.g. past a door jamb), the residual is point-to-point instead: point-to-line alone would let a
-//! scan slide along a corridor, since only the ends of walls say where along it the robot is.
+//! `end_tangent`, e.g. past a door jamb), the residual is point-to-point instead:
+//! point-to-line alone would let a scan slide along a corridor, since only the ends of walls
+//! say where along it the robot is.
 //! Pairs farther apart than a gate are dropped; the gate shrinks geometrically from `gate_start`
 //! to `gate_end`, and a Huber weight tempers the remaining outliers. A tiny Levenberg damping
 //! keeps directions the scene does not constrain at all where the coarse search put them.
@@ -91,11 +92,11 @@ impl Reference<'_> {
             if !continues {
                 continue;
             }
-            // projection of q on the segment, in units of its length
-            let u = (dx * ex + dy * ey) / len2;
+            // q's offset along the segment from a: past a, and at most end_tangent past b
             let len = len2.sqrt();
-            if u > 0.0 && u * len <= len + end_tangent {
-                let inv = 1.0 / len;
+            let inv = 1.0 / len;
+            let offset = (dx * ex + dy * ey) * inv;
+            if offset > 0.0 && offset <= len + end_tangent {
                 let mut m = [-ey * inv, ex * inv];
                 if m[0] * n[0] + m[1] * n[1] < 0.0 {
                     m = [-m[0], -m[1]];

@@ -329,8 +329,9 @@ pub(crate) fn match_improved(
             best = Some(c);
         }
     }
+    let (mut transform, _, mut inliers) = best.unwrap_or(([0.0; 3], 0.0, 0));
     // 8. precise refinement of the winner
-    if let Some(b) = best {
+    if best.is_some() {
         let precise = RefineParams {
             iterations: cfg.final_iterations,
             gate_start: 2.0 * cfg.precise_distance,
@@ -338,16 +339,17 @@ pub(crate) fn match_improved(
             huber: cfg.precise_distance,
             end_tangent: 1.2 * cfg.precise_distance,
         };
-        let r = keep_inside(refine(&judge.model, &cur_fine, b.0, &precise).x, b.0);
+        let r = keep_inside(
+            refine(&judge.model, &cur_fine, transform, &precise).x,
+            transform,
+        );
         evaluations += cfg.final_iterations as u64 + 1;
-        let near = (r[0] - b.0[0]).hypot(r[1] - b.0[1]) < cfg.precise_reach as f64
-            && wrap_angle(r[2] - b.0[2]).abs() < (cfg.precise_reach_deg as f64).to_radians();
+        let near = (r[0] - transform[0]).hypot(r[1] - transform[1]) < cfg.precise_reach as f64
+            && wrap_angle(r[2] - transform[2]).abs() < (cfg.precise_reach_deg as f64).to_radians();
         if near {
-            let (score, inl) = judge.score(&cur_fine, &ref_fine, &r);
-            best = Some((r, score, inl));
+            (transform, inliers) = (r, judge.inliers(&cur_fine, &r));
         }
     }
-    let (transform, _, inliers) = best.unwrap_or(([0.0; 3], 0.0, 0));
     Ok(ImprovedOutcome {
         transform: [transform[0], transform[1], wrap_angle(transform[2])],
         inliers: inliers as f64 / n_fine,
