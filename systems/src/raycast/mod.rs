@@ -19,6 +19,7 @@
 mod batch;
 mod dda;
 mod fan;
+mod leap;
 mod overlay;
 mod raymap;
 pub mod sweep;

@@ -4,13 +4,14 @@
 //! (every cell it can reach is within Chebyshev distance k − 1 of its cell), so it leaps across
 //! open space — sphere tracing with a conservative metric — and near obstacles it walks cell by
 //! cell exactly like Amanatides & Woo. Crossing times are computed from the ray's origin, so hits
-//! agree with [`super::cast_dda`].
+//! agree with [`super::cast_dda`]. The walk itself is `super::leap`.
 //!
 //! Memory layout: cells are stored in 8 × 8 tiles of 64 bytes (one cache line), so the cells
 //! around a ray share few cache lines; measured, memory latency — not arithmetic — dominates
 //! random rays on a row-major map.
 
-use super::dda::{Ray, enter_grid};
+use super::dda::enter_grid;
+use super::leap::{Bounds, Lane};
 use super::sweep::{Faces, TILE as FACE_TILE};
 
 /// Distances are capped, so an edit only changes the field within this many cells.
@@ -227,6 +228,10 @@ impl RayMap {
     fn cast_dir(&self, p: [f32; 2], dx: f32, dy: f32, max_range: f32) -> f32 {
         let gx = p[0] - self.origin[0];
         let gy = p[1] - self.origin[1];
+        if !(gx.is_finite() && gy.is_finite() && dx.is_finite() && dy.is_finite()) {
+            // no defined ray (a NaN or infinite pose): nothing to walk along
+            return f32::NAN;
+        }
         let (wf, hf) = (self.w as f32 * self.res, self.h as f32 * self.res);
         let t0 = if gx >= 0.0 && gy >= 0.0 && gx < wf && gy < hf {
             0.0
@@ -236,29 +241,14 @@ impl RayMap {
                 None => return f32::INFINITY,
             }
         };
-        let ray = Ray::new(gx, gy, dx, dy, self.res);
-        let leap = self.res / dx.abs().max(dy.abs());
-        let (w, h) = (self.w as i32, self.h as i32);
-        let mut walk = ray.walk_at(t0, w, h);
+        let b = Bounds::new(self.w, self.h, self.res);
+        let mut lane = Lane::new(gx, gy, dx, dy, t0, &b);
         loop {
-            let k = self.dist[self.idx(walk.cx as usize, walk.cy as usize)];
+            let k = self.dist[self.idx(lane.cx as usize, lane.cy as usize)];
             if k == 0 {
-                return walk.t;
+                return lane.t;
             }
-            if k >= 3 {
-                let t = walk.t + (k - 1) as f32 * leap;
-                if t > max_range {
-                    return f32::INFINITY;
-                }
-                let (px, py) = (gx + dx * t, gy + dy * t);
-                if px < 0.0 || py < 0.0 || px >= wf || py >= hf {
-                    return f32::INFINITY;
-                }
-                walk = ray.walk_at(t, w, h);
-                continue;
-            }
-            walk.step();
-            if walk.t > max_range || walk.cx < 0 || walk.cy < 0 || walk.cx >= w || walk.cy >= h {
+            if !lane.exit_square(k, &b, max_range) {
                 return f32::INFINITY;
             }
         }

@@ -1,0 +1,178 @@
+//! One ray's walk on the distance field of [`super::RayMap`]: the state and the move every
+//! distance-field kernel uses ([`super::RayMap::cast`] one ray at a time, the ray streams of
+//! `batch` several in turn).
+//!
+//! A cell whose value is k ≥ 2 is the centre of a free square of cells within L∞ distance
+//! k − 1 (the Chebyshev distance transform's meaning), so from the point where the ray entered
+//! the cell it can advance an L∞ distance of k − 1 cells without meeting an obstacle: a leap
+//! across open space, sphere tracing with the L∞ metric. Next to an obstacle (k = 1) it takes
+//! the Amanatides & Woo (1987) cell step, the crossing time computed from the ray's origin and
+//! the cell indices (never accumulated), so the hit parameter is the boundary crossing into the
+//! first occupied cell, as in [`super::cast_dda`].
+//!
+//! Two moves, one per use. [`Lane::advance`] leaps the inscribed L∞ distance k − 1 from the
+//! cell's entry point: few operations, for the streams, whose cost is arithmetic once the loads
+//! of several rays overlap. [`Lane::exit_square`] leaves the whole free square (its far boundary
+//! on either axis, k − 1 to k cells, into the first cell outside it): more arithmetic but fewer
+//! moves, for a single ray, whose cost is the chain of dependent loads (measured on the
+//! hospital: 10.3 against 8.2 M single rays/s; the streams 16.9 against 11.1 M rays/s the
+//! other way round).
+
+use super::dda::step_sign;
+
+/// A ray in grid-relative metres, and the cell it is in.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Lane {
+    gx: f32,
+    gy: f32,
+    dx: f32,
+    dy: f32,
+    /// 1/dx, 1/dy (finite: only used when the step sign is non-zero).
+    idx: f32,
+    idy: f32,
+    /// Cell steps and the offsets (0 or 1) of the next boundary.
+    sx: i32,
+    sy: i32,
+    bx: i32,
+    by: i32,
+    /// Length of one cell of L∞ travel along the ray.
+    leap: f32,
+    pub cx: i32,
+    pub cy: i32,
+    /// Parameter at which the ray entered the current cell (or landed in it after a leap).
+    pub t: f32,
+    /// Output slot (for the streams).
+    pub id: usize,
+}
+
+/// The grid a walk runs on: size in cells and cell size.
+#[derive(Clone, Copy)]
+pub(super) struct Bounds {
+    pub w: i32,
+    pub h: i32,
+    pub res: f32,
+    pub inv_res: f32,
+    /// Size in metres.
+    pub wf: f32,
+    pub hf: f32,
+}
+
+impl Bounds {
+    pub fn new(w: usize, h: usize, res: f32) -> Bounds {
+        Bounds {
+            w: w as i32,
+            h: h as i32,
+            res,
+            inv_res: 1.0 / res,
+            wf: w as f32 * res,
+            hf: h as f32 * res,
+        }
+    }
+}
+
+impl Lane {
+    /// The ray from (gx, gy) along the unit direction (dx, dy), at parameter t, which must be a
+    /// point inside the grid.
+    #[inline(always)]
+    pub fn new(gx: f32, gy: f32, dx: f32, dy: f32, t: f32, b: &Bounds) -> Lane {
+        let (sx, sy) = (step_sign(dx), step_sign(dy));
+        Lane {
+            gx,
+            gy,
+            dx,
+            dy,
+            idx: if sx != 0 { 1.0 / dx } else { 0.0 },
+            idy: if sy != 0 { 1.0 / dy } else { 0.0 },
+            sx,
+            sy,
+            bx: (sx > 0) as i32,
+            by: (sy > 0) as i32,
+            leap: b.res / dx.abs().max(dy.abs()),
+            cx: (((gx + dx * t) * b.inv_res) as i32).clamp(0, b.w - 1),
+            cy: (((gy + dy * t) * b.inv_res) as i32).clamp(0, b.h - 1),
+            t,
+            id: 0,
+        }
+    }
+
+    /// One move from the current cell, whose distance value is `k` ≥ 1: a leap of k − 1 cells
+    /// of L∞ travel or a cell step (see the module doc).
+    /// Returns false when the ray leaves the grid or passes `max_range` (no hit).
+    #[inline(always)]
+    pub fn advance(&mut self, k: u8, b: &Bounds, max_range: f32) -> bool {
+        if k >= 2 {
+            let t = self.t + (k - 1) as f32 * self.leap;
+            let (px, py) = (self.gx + self.dx * t, self.gy + self.dy * t);
+            if t > max_range || px < 0.0 || py < 0.0 || px >= b.wf || py >= b.hf {
+                return false;
+            }
+            self.t = t;
+            self.cx = ((px * b.inv_res) as i32).min(b.w - 1);
+            self.cy = ((py * b.inv_res) as i32).min(b.h - 1);
+            return true;
+        }
+        let tx = if self.sx != 0 {
+            ((self.cx + self.bx) as f32 * b.res - self.gx) * self.idx
+        } else {
+            f32::INFINITY
+        };
+        let ty = if self.sy != 0 {
+            ((self.cy + self.by) as f32 * b.res - self.gy) * self.idy
+        } else {
+            f32::INFINITY
+        };
+        // never back along the ray: a ray running along a cell boundary can find the boundary
+        // it crosses a rounding error behind it, and leaping on from there could cycle between
+        // two cells for ever
+        if tx < ty {
+            self.t = tx.max(self.t);
+            self.cx += self.sx;
+        } else {
+            self.t = ty.max(self.t);
+            self.cy += self.sy;
+        }
+        !(self.t > max_range || self.cx < 0 || self.cy < 0 || self.cx >= b.w || self.cy >= b.h)
+    }
+
+    /// One move out of the free square around the current cell, whose distance value is `k` ≥ 1
+    /// (with k = 1 the square is the cell, and this is the cell step). Returns false when the
+    /// ray leaves the grid or passes `max_range`. Cell indices never move backwards, so a walk
+    /// always ends.
+    #[inline(always)]
+    pub fn exit_square(&mut self, k: u8, b: &Bounds, max_range: f32) -> bool {
+        let k = k as i32;
+        let m = k - 1;
+        let tx = if self.sx != 0 {
+            ((self.cx + self.bx + self.sx * m) as f32 * b.res - self.gx) * self.idx
+        } else {
+            f32::INFINITY
+        };
+        let ty = if self.sy != 0 {
+            ((self.cy + self.by + self.sy * m) as f32 * b.res - self.gy) * self.idy
+        } else {
+            f32::INFINITY
+        };
+        // `max`: never back along the ray, as in `advance`
+        if tx < ty {
+            self.t = tx.max(self.t);
+            self.cx += self.sx * k;
+            self.cy = across(self.gy, self.dy, self.t, b.inv_res, self.cy, self.sy * m);
+        } else {
+            self.t = ty.max(self.t);
+            self.cy += self.sy * k;
+            self.cx = across(self.gx, self.dx, self.t, b.inv_res, self.cx, self.sx * m);
+        }
+        !(self.t > max_range || self.cx < 0 || self.cy < 0 || self.cx >= b.w || self.cy >= b.h)
+    }
+}
+
+/// The cell index on the axis the ray did not exit through: where the ray is at `t`, kept
+/// between the current index `c` and the square's side `span` = ±m cells ahead (rounding can put
+/// the point a hair outside), never behind `c`.
+#[inline(always)]
+fn across(g: f32, d: f32, t: f32, inv_res: f32, c: i32, span: i32) -> i32 {
+    // floor for points above −1 cell (truncation plus a bias: `floor` is a libm call on the
+    // baseline x86-64 target), enough since the result is clamped next to `c` ≥ 0
+    let at = ((g + d * t) * inv_res + 1.0) as i32 - 1;
+    at.clamp(c + span.min(0), c + span.max(0))
+}
