@@ -8,7 +8,6 @@
 //! This is what a particle filter needs (every particle's beams at once: the `calc_range_many`
 //! of range_libc, Walsh & Karaman 2018) and what scans fall back to when the sweep does not apply.
 
-use super::dda::enter_grid;
 use super::leap::{Bounds, Lane};
 use super::raymap::RayMap;
 
@@ -41,7 +40,6 @@ impl RayMap {
         out: &mut [f32],
     ) {
         let b = Bounds::new(self.width(), self.height(), self.resolution());
-        let (wf, hf) = (b.wf, b.hf);
         let origin = self.origin();
         let dist = self.dist();
         let mut lanes = [Lane::default(); LANES];
@@ -54,22 +52,13 @@ impl RayMap {
                 *next += 1;
                 let (p, dx, dy) = ray(i);
                 let (gx, gy) = (p[0] - origin[0], p[1] - origin[1]);
-                if !(gx.is_finite() && gy.is_finite() && dx.is_finite() && dy.is_finite()) {
-                    // no defined ray (a NaN or infinite pose): nothing to walk along
-                    out[i] = f32::NAN;
-                    continue;
-                }
-                let mut t = 0.0;
-                if !(gx >= 0.0 && gy >= 0.0 && gx < wf && gy < hf) {
-                    match enter_grid(gx, gy, dx, dy, wf, hf, max_range) {
-                        Some(t0) => t = t0,
-                        None => {
-                            out[i] = f32::INFINITY;
-                            continue;
-                        }
+                match Lane::start(gx, gy, dx, dy, &b, max_range) {
+                    Ok(l) => *lane = l,
+                    Err(answer) => {
+                        out[i] = answer;
+                        continue;
                     }
                 }
-                *lane = Lane::new(gx, gy, dx, dy, t, &b);
                 lane.id = i;
                 return true;
             }

@@ -10,7 +10,6 @@
 //! around a ray share few cache lines; measured, memory latency — not arithmetic — dominates
 //! random rays on a row-major map.
 
-use super::dda::enter_grid;
 use super::leap::{Bounds, Lane};
 use super::sweep::{Faces, TILE as FACE_TILE};
 
@@ -226,23 +225,12 @@ impl RayMap {
     }
 
     fn cast_dir(&self, p: [f32; 2], dx: f32, dy: f32, max_range: f32) -> f32 {
-        let gx = p[0] - self.origin[0];
-        let gy = p[1] - self.origin[1];
-        if !(gx.is_finite() && gy.is_finite() && dx.is_finite() && dy.is_finite()) {
-            // no defined ray (a NaN or infinite pose): nothing to walk along
-            return f32::NAN;
-        }
-        let (wf, hf) = (self.w as f32 * self.res, self.h as f32 * self.res);
-        let t0 = if gx >= 0.0 && gy >= 0.0 && gx < wf && gy < hf {
-            0.0
-        } else {
-            match enter_grid(gx, gy, dx, dy, wf, hf, max_range) {
-                Some(t) => t,
-                None => return f32::INFINITY,
-            }
-        };
         let b = Bounds::new(self.w, self.h, self.res);
-        let mut lane = Lane::new(gx, gy, dx, dy, t0, &b);
+        let (gx, gy) = (p[0] - self.origin[0], p[1] - self.origin[1]);
+        let mut lane = match Lane::start(gx, gy, dx, dy, &b, max_range) {
+            Ok(lane) => lane,
+            Err(answer) => return answer,
+        };
         loop {
             let k = self.dist[self.idx(lane.cx as usize, lane.cy as usize)];
             if k == 0 {
