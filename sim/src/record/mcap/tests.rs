@@ -316,3 +316,26 @@ fn a_write_error_is_reported_by_flush_and_by_finish() {
     let e2 = format!("{:#}", rec.finish().unwrap_err());
     assert_eq!(e2, e, "the first error again");
 }
+
+#[test]
+fn channel_ids_run_from_one_and_run_out_with_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("many.mcap");
+    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let first = rec.channel::<Range>("/sonar/0").unwrap();
+    let again = rec.channel::<Range>("/sonar/0").unwrap();
+    assert_eq!((first.id(), again.id()), (1, 1));
+    for k in 1..u16::MAX {
+        let ch = rec.channel::<Range>(&format!("/sonar/{k}")).unwrap();
+        assert_eq!(ch.id(), k + 1);
+    }
+    let Err(e) = rec.channel::<Range>("/one/too/many") else {
+        panic!("a channel id beyond u16");
+    };
+    assert_eq!(
+        e.to_string(),
+        format!("{}: too many channels", path.display())
+    );
+    let stats = rec.finish().unwrap();
+    assert_eq!(stats.channels, u16::MAX as usize);
+}

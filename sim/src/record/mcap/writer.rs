@@ -116,14 +116,14 @@ enum Op {
         msg: Box<dyn Encode>,
     },
     Schema {
+        id: u16,
         name: &'static str,
         definition: &'static str,
-        reply: Reply<u16>,
     },
     Channel {
+        id: u16,
         schema: u16,
         topic: String,
-        reply: Reply<u16>,
     },
     Attach {
         name: String,
@@ -260,7 +260,8 @@ impl McapRecorder {
 
     /// Registers `topic` for messages of type `T` (the schema is written once per type).
     /// Asking again for the same topic and type gives the same channel; another type is an
-    /// error.
+    /// error. The records are written by the writer thread, which reports a failure like a
+    /// write error (at the next [`McapRecorder::flush`] or at [`McapRecorder::finish`]).
     pub fn channel<T: RosMessage>(&mut self, topic: &str) -> anyhow::Result<Channel<T>> {
         if let Some(&(id, name)) = self.topics.get(topic) {
             if name != T::NAME {
@@ -275,23 +276,29 @@ impl McapRecorder {
                 _type: PhantomData,
             });
         }
+        // ids are given here, as `mcap`'s own allocator would give them (from 1, in order of
+        // registration), so registering never waits for the writer thread
         let schema = match self.schemas.get(T::NAME) {
             Some(&id) => id,
             None => {
-                let id = self.ask(|reply| Op::Schema {
+                let id = u16::try_from(self.schemas.len() + 1)
+                    .map_err(|_| anyhow!("{}: too many schemas", self.path.display()))?;
+                self.batch.ops.push(Op::Schema {
+                    id,
                     name: T::NAME,
                     definition: T::DEFINITION,
-                    reply,
-                })?;
+                });
                 self.schemas.insert(T::NAME, id);
                 id
             }
         };
-        let id = self.ask(|reply| Op::Channel {
+        let id = u16::try_from(self.topics.len() + 1)
+            .map_err(|_| anyhow!("{}: too many channels", self.path.display()))?;
+        self.batch.ops.push(Op::Channel {
+            id,
             schema,
             topic: topic.to_string(),
-            reply,
-        })?;
+        });
         self.topics.insert(topic.to_string(), (id, T::NAME));
         Ok(Channel {
             id,
@@ -453,30 +460,41 @@ impl FileWriter {
                         let _ = reply.send(r);
                     }
                     Op::Schema {
+                        id,
                         name,
                         definition,
-                        reply,
                     } => {
-                        let r = self
-                            .writer
-                            .add_schema(name, SCHEMA_ENCODING, definition.as_bytes())
-                            .map_err(|e| self.error(&format!("add the schema {name}"), e));
-                        let _ = reply.send(r);
+                        if error.is_none() {
+                            error = self
+                                .writer
+                                .add_schema_with_id(
+                                    id,
+                                    name,
+                                    SCHEMA_ENCODING,
+                                    definition.as_bytes(),
+                                )
+                                .map_err(|e| self.error(&format!("add the schema {name}"), e))
+                                .err();
+                        }
                     }
-                    Op::Channel {
-                        schema,
-                        topic,
-                        reply,
-                    } => {
+                    Op::Channel { id, schema, topic } => {
                         // The `ros2` profile requires this key; empty means "no recorded QoS",
                         // which rosbag2 reads as its default profile.
                         let metadata =
                             BTreeMap::from([("offered_qos_profiles".to_string(), String::new())]);
-                        let r = self
-                            .writer
-                            .add_channel(schema, &topic, MESSAGE_ENCODING, &metadata)
-                            .map_err(|e| self.error(&format!("add the channel {topic}"), e));
-                        let _ = reply.send(r);
+                        if error.is_none() {
+                            error = self
+                                .writer
+                                .add_channel_with_id(
+                                    id,
+                                    schema,
+                                    &topic,
+                                    MESSAGE_ENCODING,
+                                    &metadata,
+                                )
+                                .map_err(|e| self.error(&format!("add the channel {topic}"), e))
+                                .err();
+                        }
                     }
                 }
             }
