@@ -7,7 +7,6 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use std::path::Path;
 use systems::core::{Pose2, stream_rng};
 use systems::navigation::road_follow::{RoadFollowParams, road_steering};
 use systems::navigation::road_recognition::{RecognitionConfig, RoadRecognizer};
@@ -16,8 +15,8 @@ use systems::world::roads::surface_raster::{DEFAULT_MARGIN, DEFAULT_RESOLUTION};
 use systems::world::roads::{RoadGraph, RoadOptions, SurfaceRaster, load_roads};
 
 fn park() -> RoadGraph {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/roads/park/park.osm");
-    load_roads(Path::new(path), &RoadOptions::default()).unwrap()
+    let path = systems::core::source::source_path("assets/roads/park/park.osm");
+    load_roads(&path, &RoadOptions::default()).unwrap()
 }
 
 /// 3 m from OSM node 82 towards node 15 on Basilica Avenue, heading along it.

@@ -16,7 +16,6 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::f64::consts::PI;
 use std::hint::black_box;
-use std::path::Path;
 use std::time::{Duration, Instant};
 use systems::core::{Pose2, stream_rng};
 use systems::mapping::pose_graph::{OptimizeParams, optimize, synthetic};
@@ -41,7 +40,7 @@ fn crop(grid: &OccupancyGrid, x0: f64, y0: f64, w: f64, h: f64) -> OccupancyGrid
 }
 
 fn bench_bnb(c: &mut Criterion) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/maps/hospital/hospital.yaml");
+    let path = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
     let map = load_map(&path).expect("the hospital map loads");
     let rays = RayMap::from_grid(&map);
     let submap = likelihood_grid(&crop(&map, 17.0, 1.0, 30.0, 30.0), 0.1);

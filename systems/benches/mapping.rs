@@ -14,7 +14,6 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use std::f64::consts::PI;
 use std::hint::black_box;
-use std::path::Path;
 use std::time::Duration;
 use systems::core::{Pose2, stream_rng};
 use systems::mapping::{LogOddsMap, OccupancyParams, map_quality};
@@ -23,7 +22,7 @@ use systems::sensors::{LaserScan, LaserSpec};
 use systems::world::{Cell, load_map};
 
 fn bench(c: &mut Criterion) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/maps/hospital/hospital.yaml");
+    let path = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
     let truth = load_map(&path).expect("the hospital map loads");
     let rays = RayMap::from_grid(&truth);
     let spec = LaserSpec::sick_lms100();

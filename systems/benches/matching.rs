@@ -16,7 +16,6 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use std::f64::consts::PI;
 use std::hint::black_box;
-use std::path::Path;
 use std::time::Duration;
 use systems::core::{Pose2, SimRng, stream_rng};
 use systems::matching::{
@@ -35,8 +34,7 @@ struct Hospital {
 
 impl Hospital {
     fn load() -> Hospital {
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/maps/hospital/hospital.yaml");
+        let path = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
         let grid = load_map(&path).expect("the hospital map loads");
         let map = RayMap::new(
             grid.width,

@@ -5,7 +5,6 @@
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
-use std::path::Path;
 use systems::navigation::{Costmap, CostmapParams, Planner, PlannerParams};
 use systems::world::{OccupancyGrid, load_map};
 
@@ -18,11 +17,8 @@ const PAIRS: [(&str, [f64; 2], [f64; 2]); 4] = [
 ];
 
 fn hospital() -> OccupancyGrid {
-    let yaml = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/maps/hospital/hospital.yaml"
-    );
-    load_map(Path::new(yaml)).unwrap()
+    let yaml = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
+    load_map(&yaml).unwrap()
 }
 
 fn params() -> CostmapParams {

@@ -5,7 +5,6 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::RngExt;
 use std::hint::black_box;
-use std::path::Path;
 use systems::core::stream_rng;
 use systems::raycast::{RayMap, cast_dda};
 use systems::world::{OccupancyGrid, load_map};
@@ -50,7 +49,7 @@ fn setup(name: &'static str, grid: OccupancyGrid) -> Setup {
 }
 
 fn bench(c: &mut Criterion) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/maps/hospital/hospital.yaml");
+    let path = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
     let hospital = load_map(&path).expect("the hospital map loads");
     let setups = [
         setup("hospital", hospital.clone()),

@@ -17,7 +17,6 @@ use rand::RngExt;
 use rand_distr::StandardNormal;
 use std::f64::consts::PI;
 use std::hint::black_box;
-use std::path::Path;
 use std::time::Duration;
 use systems::core::{Pose2, SimRng, stream_rng, wrap_angle};
 use systems::matching::{
@@ -77,7 +76,7 @@ fn cases(grid: &OccupancyGrid, map: &RayMap) -> Vec<Case> {
 }
 
 fn bench(c: &mut Criterion) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/maps/hospital/hospital.yaml");
+    let path = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
     let grid = load_map(&path).expect("the hospital map loads");
     let map = RayMap::from_grid(&grid);
     let prob = ProbGrid::from_occupancy(&grid);

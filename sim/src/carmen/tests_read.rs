@@ -6,11 +6,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../tests/fixtures/carmen"
-    ))
-    .join(name)
+    systems::core::source::source_path("tests/fixtures/carmen").join(name)
 }
 
 fn read(name: &str) -> CarmenLog {

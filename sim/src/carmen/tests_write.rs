@@ -220,8 +220,8 @@ fn garbage_and_truncated_lines_never_panic() {
         "params.log",
         "unknown_types.log",
     ] {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/fixtures/carmen/");
-        let text = std::fs::read_to_string(format!("{path}{name}")).unwrap();
+        let path = systems::core::source::source_path("tests/fixtures/carmen").join(name);
+        let text = std::fs::read_to_string(path).unwrap();
         seeds.extend(text.lines().map(String::from));
     }
     let junk = [

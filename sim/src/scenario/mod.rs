@@ -175,11 +175,12 @@ pub fn parse_scenario(
     resolve::resolve(text, file_label, base_dir, default_name)
 }
 
-/// The folder of the bundled assets: `$SIM_ASSETS` or the repository's `assets/`.
+/// The folder of the bundled assets: `$SIM_ASSETS` or the repository's `assets/`
+/// ([`systems::core::source`]).
 pub fn assets_dir() -> PathBuf {
     match std::env::var_os("SIM_ASSETS") {
         Some(p) => PathBuf::from(p),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets"),
+        None => systems::core::source::source_path("assets"),
     }
 }
 

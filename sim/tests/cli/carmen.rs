@@ -2,11 +2,9 @@
 //! messages, printed counts and default file names.
 
 use super::{ROOM, expect_failure, run_ok};
-use std::path::Path;
 
 fn fixture(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/fixtures/carmen")
+    systems::core::source::source_path("tests/fixtures/carmen")
         .join(name)
         .display()
         .to_string()

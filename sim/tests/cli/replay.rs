@@ -1,13 +1,12 @@
 //! `sim replay` exit codes and messages for files it cannot use.
 
 use super::{expect_failure, run_ok};
-use std::path::Path;
 
 #[test]
 fn corrupt_truncated_and_foreign_files_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let cwd = dir.path();
-    let recording = Path::new(env!("CARGO_MANIFEST_DIR")).join("../replays/hospital_r1-seed0.mcap");
+    let recording = systems::core::source::source_path("replays/hospital_r1-seed0.mcap");
     let bytes = std::fs::read(&recording).unwrap();
     std::fs::write(cwd.join("cut.mcap"), &bytes[..bytes.len() * 2 / 3]).unwrap();
     expect_failure(&["replay", "cut.mcap"], cwd, &["cut.mcap"]);

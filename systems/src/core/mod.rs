@@ -1,5 +1,6 @@
 //! Components and resources every system shares: poses, the simulation clock, per-entity random
-//! streams, robot identity, the tick schedule and the kernel thread pool.
+//! streams, robot identity, the tick schedule and the kernel thread pool (and where the source
+//! tree is, for its assets).
 
 pub mod clock;
 pub mod ids;
@@ -8,6 +9,7 @@ pub mod pool;
 pub mod pose;
 pub mod rng;
 pub mod schedule;
+pub mod source;
 
 pub use clock::SimClock;
 pub use ids::{RobotId, RobotIndex};

@@ -15,11 +15,8 @@ pub const CORRIDOR: [[f64; 2]; 4] = [[2.2, 16.0], [21.25, 16.0], [21.25, 24.75],
 
 /// The bundled hospital map of this source tree, with distances up to 2 m.
 pub fn hospital() -> LocalizationMap {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/maps/hospital/hospital.yaml"
-    );
-    map_from(Path::new(path)).unwrap()
+    let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
+    map_from(&path).unwrap()
 }
 
 /// A map file (YAML) as localizers see it, with distances up to 2 m.

@@ -9,10 +9,9 @@ use crate::sensors::{LaserScan, LaserSpec};
 use crate::world::{OccupancyGrid, load_map};
 use rand::RngExt;
 use rand_distr::StandardNormal;
-use std::path::Path;
 
 pub(super) fn hospital() -> OccupancyGrid {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/maps/hospital/hospital.yaml");
+    let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
     load_map(&path).expect("the hospital map loads")
 }
 

@@ -18,11 +18,8 @@ pub(super) struct Hospital {
 pub(super) fn hospital() -> &'static Hospital {
     static H: OnceLock<Hospital> = OnceLock::new();
     H.get_or_init(|| {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../assets/maps/hospital/hospital.yaml"
-        );
-        let grid = load_map(std::path::Path::new(path)).expect("the hospital map loads");
+        let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
+        let grid = load_map(&path).expect("the hospital map loads");
         let map = RayMap::new(
             grid.width,
             grid.height,

@@ -282,12 +282,10 @@ mod tests {
         // assets/roads: the short route starts at node 37 on Orchard Path facing 344°, away
         // from its goal, node 10; turning round would make it 67.9 m, the route without a
         // U-turn is 190.2 m (the generator's own Dijkstra, `generate_park.py --check`)
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/roads/park/park.osm");
-        let g = crate::world::roads::load_roads(
-            std::path::Path::new(path),
-            &crate::world::roads::RoadOptions::default(),
-        )
-        .unwrap();
+        let path = crate::core::source::source_path("assets/roads/park/park.osm");
+        let g =
+            crate::world::roads::load_roads(&path, &crate::world::roads::RoadOptions::default())
+                .unwrap();
         let junctions = (0..g.nodes.len()).filter(|&n| g.degree(n) != 2).count();
         assert!(junctions >= 30, "{junctions} junctions and road ends");
         assert!((0..g.nodes.len()).any(|n| g.degree(n) >= 4));

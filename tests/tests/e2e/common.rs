@@ -61,7 +61,7 @@ pub fn evo_venv() -> PathBuf {
 }
 
 pub fn repo_file(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
+    systems::core::source::source_root().join("tests").join(rel)
 }
 
 /// A 10 × 10 m room (inner faces at x, y = 0.1 and 9.9) built from vector walls.

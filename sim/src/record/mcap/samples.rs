@@ -210,7 +210,7 @@ fn python_ros2_readers_decode_every_message() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sample.mcap");
     write_sample(&path);
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/check_mcap.py");
+    let script = systems::core::source::source_path("tests/check_mcap.py");
     let out = std::process::Command::new(PathBuf::from(venv).join("bin/python"))
         .arg(script)
         .arg(&path)

@@ -13,14 +13,10 @@ use crate::world::roads::{
 use crate::world::zones::{GpsZone, ZoneKind};
 use rand::RngExt;
 use rand_distr::StandardNormal;
-use std::path::PathBuf;
 
 /// The bundled park (assets/roads/park/park.osm).
 pub fn park() -> RoadGraph {
-    let path = PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/roads/park/park.osm"
-    ));
+    let path = crate::core::source::source_path("assets/roads/park/park.osm");
     load_roads(&path, &RoadOptions::default()).expect("park.osm")
 }
 

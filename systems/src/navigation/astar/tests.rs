@@ -241,11 +241,8 @@ fn costs_are_optimal_on_cluttered_maps() {
 
 #[test]
 fn cross_building_path_on_the_hospital_map() {
-    let yaml = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/maps/hospital/hospital.yaml"
-    );
-    let grid = load_map(std::path::Path::new(yaml)).unwrap();
+    let yaml = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
+    let grid = load_map(&yaml).unwrap();
     let map = Costmap::from_grid(&grid, &CostmapParams::default());
     let mut p = Planner::new(PlannerParams::default());
     for (a, b) in [([2.0, 4.5], [62.0, 28.0]), ([3.0, 16.5], [61.0, 16.5])] {

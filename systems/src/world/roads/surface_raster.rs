@@ -197,10 +197,7 @@ pub(crate) fn park_fixture() -> &'static (RoadGraph, std::sync::Arc<SurfaceRaste
     static PARK: std::sync::OnceLock<(RoadGraph, std::sync::Arc<SurfaceRaster>)> =
         std::sync::OnceLock::new();
     PARK.get_or_init(|| {
-        let path = std::path::PathBuf::from(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../assets/roads/park/park.osm"
-        ));
+        let path = crate::core::source::source_path("assets/roads/park/park.osm");
         let g = super::load_roads(&path, &super::RoadOptions::default()).unwrap();
         let r = SurfaceRaster::build(&g, DEFAULT_RESOLUTION, DEFAULT_MARGIN);
         (g, std::sync::Arc::new(r))

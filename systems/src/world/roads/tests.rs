@@ -2,11 +2,7 @@ use super::*;
 use std::path::PathBuf;
 
 fn fixture(name: &str) -> PathBuf {
-    PathBuf::from(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../tests/fixtures/roads"
-    ))
-    .join(name)
+    crate::core::source::source_path("tests/fixtures/roads").join(name)
 }
 
 fn options() -> RoadOptions {
@@ -233,7 +229,7 @@ fn widths_and_surfaces_parse_like_osm_writes_them() {
 
 #[test]
 fn the_bundled_park_reads_the_same_from_osm_and_gpx() {
-    let dir = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/roads/park"));
+    let dir = crate::core::source::source_path("assets/roads/park");
     let osm = load_roads(&dir.join("park.osm"), &RoadOptions::default()).unwrap();
     let gpx = load_roads(&dir.join("park.gpx"), &RoadOptions::default()).unwrap();
     // assets/roads/README.md: 179 nodes, 195 edges, 2256.6 m; the building and the wood skipped
