@@ -98,6 +98,7 @@ impl RecordedFrames {
         let worker = std::thread::Builder::new()
             .name("camera frames".into())
             .spawn(move || {
+                super::priority::background_thread();
                 for job in queue {
                     if finished.send(render(job, outputs)).is_err() {
                         break;

@@ -193,11 +193,14 @@ pub fn open_recording(path: &Path, name: &str) -> anyhow::Result<rerun::Recordin
         flush_num_bytes: 1024 * 1024,
         ..rerun::log::ChunkBatcherConfig::DEFAULT
     };
-    let rec = rerun::RecordingStreamBuilder::new("sim")
-        .recording_name(name)
-        .batcher_config(batcher)
-        .save(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot create the recording: {e}", path.display()))?;
+    // the SDK starts its batcher and file-writer threads here: at background priority
+    let rec = super::priority::in_background(|| {
+        rerun::RecordingStreamBuilder::new("sim")
+            .recording_name(name)
+            .batcher_config(batcher)
+            .save(path)
+    })
+    .map_err(|e| anyhow::anyhow!("{}: cannot create the recording: {e}", path.display()))?;
     rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
         .map_err(|e| anyhow::anyhow!("{}: cannot write the recording: {e}", path.display()))?;
     Ok(rec)

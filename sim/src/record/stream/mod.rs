@@ -74,6 +74,7 @@ impl RrdStream {
         let chunker = std::thread::Builder::new()
             .name("rrd chunks".into())
             .spawn(move || {
+                crate::record::priority::background_thread();
                 let mut error = None;
                 for mut columns in queue {
                     match columns.build() {

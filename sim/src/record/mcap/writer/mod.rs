@@ -184,7 +184,10 @@ impl McapRecorder {
         let (done, spare) = mpsc::channel();
         let worker = std::thread::Builder::new()
             .name("mcap writer".into())
-            .spawn(move || file.run(queue, done))
+            .spawn(move || {
+                crate::record::priority::background_thread();
+                file.run(queue, done)
+            })
             .map_err(|e| anyhow!("{}: cannot start the writer thread: {e}", path.display()))?;
         Ok(McapRecorder {
             path: path.to_path_buf(),
