@@ -345,7 +345,7 @@ fn dispatch(cmd: Command) -> anyhow::Result<()> {
         }
         Command::Slam(args) => run_slam_command(&args).map(|_| ()),
         Command::Scenarios => {
-            for (name, path) in bundled_scenarios() {
+            for (name, path) in bundled_scenarios()? {
                 let desc = load_scenario(&path)
                     .map(|s| s.description)
                     .unwrap_or_else(|e| format!("(invalid: {e})"));

@@ -1,9 +1,7 @@
 //! `sim run`: its arguments and what it does with them (the binary's `main.rs` only dispatches).
 
 use crate::runner::{RunOptions, RunOutput, run_scenario_exporting};
-use crate::scenario::{
-    DEFAULT_SCENARIO, Scenario, bundled_scenarios, find_scenario, load_scenario,
-};
+use crate::scenario::{DEFAULT_SCENARIO, Scenario, find_scenario, load_scenario};
 use crate::{RunExports, record};
 use std::path::{Path, PathBuf};
 
@@ -109,14 +107,7 @@ pub fn scenario_arg(arg: Option<&str>) -> anyhow::Result<Scenario> {
 /// The file of a scenario argument: a path, or the name of a bundled scenario (default:
 /// hospital_patrol).
 pub fn scenario_path(arg: Option<&str>) -> anyhow::Result<PathBuf> {
-    let arg = arg.unwrap_or(DEFAULT_SCENARIO);
-    find_scenario(arg).ok_or_else(|| {
-        let names: Vec<String> = bundled_scenarios().into_iter().map(|(n, _)| n).collect();
-        anyhow::anyhow!(
-            "{arg}: no such file and no bundled scenario of that name (bundled: {})",
-            names.join(", ")
-        )
-    })
+    find_scenario(arg.unwrap_or(DEFAULT_SCENARIO))
 }
 
 /// `--duration`: a positive number of seconds.

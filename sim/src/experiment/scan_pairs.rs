@@ -37,9 +37,7 @@ pub struct ScenarioScans {
 
 /// Loads a bundled scenario by name.
 pub fn bundled(name: &str) -> anyhow::Result<Scenario> {
-    let path =
-        find_scenario(name).ok_or_else(|| anyhow::anyhow!("{name}: bundled scenario not found"))?;
-    Ok(load_scenario(&path)?)
+    Ok(load_scenario(&find_scenario(name)?)?)
 }
 
 /// Captures one scan per robot every `period_s` of `scenario` (optionally only its first

@@ -184,32 +184,45 @@ pub fn assets_dir() -> PathBuf {
     }
 }
 
-/// Bundled scenarios: (name, path).
-pub fn bundled_scenarios() -> Vec<(String, PathBuf)> {
+/// Bundled scenarios: (name, path), sorted; an error naming the folder when it cannot be read
+/// (a `sim` binary run away from its repository, without `SIM_ASSETS`).
+pub fn bundled_scenarios() -> anyhow::Result<Vec<(String, PathBuf)>> {
     let dir = assets_dir().join("scenarios");
-    let mut out: Vec<(String, PathBuf)> = std::fs::read_dir(&dir)
-        .into_iter()
-        .flatten()
+    let entries = std::fs::read_dir(&dir).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot read the bundled scenarios ({e}); set SIM_ASSETS to the repository's \
+             assets folder",
+            dir.display()
+        )
+    })?;
+    let mut out: Vec<(String, PathBuf)> = entries
         .flatten()
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
         .filter_map(|p| Some((p.file_stem()?.to_str()?.to_string(), p.clone())))
         .collect();
     out.sort();
-    out
+    Ok(out)
 }
 
 /// The scenario `sim run` uses without an argument.
 pub const DEFAULT_SCENARIO: &str = "hospital_patrol";
 
-/// Resolves a scenario argument: a path, or the name of a bundled scenario.
-pub fn find_scenario(arg: &str) -> Option<PathBuf> {
+/// Resolves a scenario argument: a path, or the name of a bundled scenario; otherwise an error
+/// that lists the bundled ones.
+pub fn find_scenario(arg: &str) -> anyhow::Result<PathBuf> {
     let p = PathBuf::from(arg);
     if p.exists() {
-        return Some(p);
+        return Ok(p);
     }
-    bundled_scenarios()
-        .into_iter()
-        .find(|(name, _)| name == arg)
-        .map(|(_, p)| p)
+    let all = bundled_scenarios()
+        .map_err(|e| anyhow::anyhow!("{arg}: no such file, and no bundled scenarios: {e}"))?;
+    if let Some((_, p)) = all.iter().find(|(name, _)| name == arg) {
+        return Ok(p.clone());
+    }
+    let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
+    anyhow::bail!(
+        "{arg}: no such file and no bundled scenario of that name (bundled: {})",
+        names.join(", ")
+    )
 }

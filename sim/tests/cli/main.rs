@@ -126,6 +126,48 @@ pub fn expect_failure(args: &[&str], cwd: &Path, fragments: &[&str]) {
 }
 
 #[test]
+fn without_the_assets_folder_bundled_names_fail_and_say_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no_assets");
+    let run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_sim"))
+            .args(args)
+            .current_dir(dir.path())
+            .env("SIM_ASSETS", &missing)
+            .output()
+            .expect("sim runs")
+    };
+    for args in [&["run", "hospital_patrol"][..], &["scenarios"][..]] {
+        let out = run(args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        for f in [
+            "no_assets",
+            "cannot read the bundled scenarios",
+            "SIM_ASSETS",
+        ] {
+            assert!(err.contains(f), "{args:?}: expected `{f}` in: {err}");
+        }
+    }
+    // a scenario file needs no bundled folder
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let out = run(&[
+        "run",
+        "tiny.toml",
+        "--duration",
+        "0.1",
+        "--no-rrd",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
 fn bad_input_exits_non_zero_with_a_clear_message() {
     let dir = tempfile::tempdir().unwrap();
     expect_failure(

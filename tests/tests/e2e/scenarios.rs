@@ -5,7 +5,7 @@ use sim::scenario::{bundled_scenarios, load_scenario};
 
 #[test]
 fn bundled_scenarios_load() {
-    let all = bundled_scenarios();
+    let all = bundled_scenarios().expect("the bundled scenarios are found");
     let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
     assert!(names.contains(&"hospital_patrol"), "{names:?}");
     assert!(names.contains(&"maze_run"), "{names:?}");
