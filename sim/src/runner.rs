@@ -487,7 +487,9 @@ fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                     },
                     odometry_heading_error_rad: m.odometry_heading_error_rad,
                     waypoints_reached: b.map_or(0, |b| b.reached),
-                    route_completed: b.is_some_and(|b| b.status == NavStatus::Arrived),
+                    // a waypoint route's behaviour arrived, or a road route reached its goal
+                    route_completed: b.is_some_and(|b| b.status == NavStatus::Arrived)
+                        || road.is_some_and(|(_, _, rm)| rm.reached),
                     final_pose: [p.x, p.y, p.theta],
                     localization,
                     navigation: nav.map(|(n, o)| navigation_summary(n, o, m)),

@@ -33,6 +33,8 @@ pub struct RobotSummary {
     pub odometry_drift_percent: f64,
     pub odometry_heading_error_rad: f64,
     pub waypoints_reached: u32,
+    /// The robot's route ended at its goal: the last waypoint of a waypoint route, or the goal
+    /// node of a road route.
     pub route_completed: bool,
     /// Final true pose [x, y, yaw].
     pub final_pose: [f64; 3],

@@ -26,6 +26,10 @@ fn the_short_park_route_reaches_its_goal_without_a_u_turn_and_is_recorded() {
         .as_ref()
         .expect("a robot with a route has a road summary");
     assert!(road.reached, "{road:#?}");
+    assert!(
+        r.route_completed,
+        "the road route's arrival completes the route"
+    );
     // the shortest path needs a U-turn (67.9 m); the planner went round (190.2 m)
     let planned = road.planned_length_m.unwrap();
     assert!(planned > 150.0, "planned {planned:.1} m");
