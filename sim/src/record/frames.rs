@@ -95,16 +95,13 @@ impl RecordedFrames {
     pub fn new(camera_rate: f64, outputs: FrameOutputs) -> anyhow::Result<Self> {
         let (jobs, queue) = mpsc::channel::<Job>();
         let (finished, done) = mpsc::channel();
-        let worker = std::thread::Builder::new()
-            .name("camera frames".into())
-            .spawn(move || {
-                super::priority::background_thread();
-                for job in queue {
-                    if finished.send(render(job, outputs)).is_err() {
-                        break;
-                    }
+        let worker = super::priority::spawn("camera frames", move || {
+            for job in queue {
+                if finished.send(render(job, outputs)).is_err() {
+                    break;
                 }
-            })?;
+            }
+        })?;
         Ok(RecordedFrames {
             period: 1.0 / camera_rate,
             outputs,

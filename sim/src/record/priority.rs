@@ -26,6 +26,19 @@ pub fn background_thread() {
     }
 }
 
+/// Starts a recording thread named `name` that runs `f` at background priority.
+pub fn spawn<T: Send + 'static>(
+    name: &str,
+    f: impl FnOnce() -> T + Send + 'static,
+) -> std::io::Result<std::thread::JoinHandle<T>> {
+    std::thread::Builder::new()
+        .name(name.into())
+        .spawn(move || {
+            background_thread();
+            f()
+        })
+}
+
 /// Runs `f` on a new background-priority thread and returns what it returns; the threads `f`
 /// starts inherit the priority (how the Rerun SDK's threads get it).
 pub fn in_background<T: Send>(f: impl FnOnce() -> T + Send) -> T {

@@ -10,9 +10,15 @@ use std::process::{Command, Output};
 
 /// Runs the `sim` binary with `args` in `cwd`.
 pub fn sim(args: &[&str], cwd: &Path) -> Output {
+    sim_env(args, cwd, &[])
+}
+
+/// [`sim`] with extra environment variables.
+pub fn sim_env(args: &[&str], cwd: &Path, env: &[(&str, &Path)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_sim"))
         .args(args)
         .current_dir(cwd)
+        .envs(env.iter().copied())
         .output()
         .expect("sim runs")
 }
@@ -129,14 +135,7 @@ pub fn expect_failure(args: &[&str], cwd: &Path, fragments: &[&str]) {
 fn without_the_assets_folder_bundled_names_fail_and_say_why() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("no_assets");
-    let run = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_sim"))
-            .args(args)
-            .current_dir(dir.path())
-            .env("SIM_ASSETS", &missing)
-            .output()
-            .expect("sim runs")
-    };
+    let run = |args: &[&str]| sim_env(args, dir.path(), &[("SIM_ASSETS", &missing)]);
     for args in [&["run", "hospital_patrol"][..], &["scenarios"][..]] {
         let out = run(args);
         assert!(!out.status.success(), "{args:?} should fail");

@@ -71,24 +71,21 @@ impl RrdStream {
         let (done, emptied) = mpsc::channel();
         let sdk = rec.clone();
         // without the thread, chunks are built on the caller's thread
-        let chunker = std::thread::Builder::new()
-            .name("rrd chunks".into())
-            .spawn(move || {
-                crate::record::priority::background_thread();
-                let mut error = None;
-                for mut columns in queue {
-                    match columns.build() {
-                        Ok(chunk) => sdk.send_chunk(chunk),
-                        Err(e) => {
-                            error.get_or_insert(e);
-                        }
+        let chunker = crate::record::priority::spawn("rrd chunks", move || {
+            let mut error = None;
+            for mut columns in queue {
+                match columns.build() {
+                    Ok(chunk) => sdk.send_chunk(chunk),
+                    Err(e) => {
+                        error.get_or_insert(e);
                     }
-                    // the stream may be flushing already
-                    let _ = done.send(columns);
                 }
-                error
-            })
-            .ok();
+                // the stream may be flushing already
+                let _ = done.send(columns);
+            }
+            error
+        })
+        .ok();
         RrdStream {
             rec,
             time: 0,

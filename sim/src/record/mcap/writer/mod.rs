@@ -182,13 +182,9 @@ impl McapRecorder {
         let file = FileWriter::new(path.to_path_buf(), writer);
         let (jobs, queue) = mpsc::sync_channel(QUEUED_BATCHES);
         let (done, spare) = mpsc::channel();
-        let worker = std::thread::Builder::new()
-            .name("mcap writer".into())
-            .spawn(move || {
-                crate::record::priority::background_thread();
-                file.run(queue, done)
-            })
-            .map_err(|e| anyhow!("{}: cannot start the writer thread: {e}", path.display()))?;
+        let worker =
+            crate::record::priority::spawn("mcap writer", move || file.run(queue, done))
+                .map_err(|e| anyhow!("{}: cannot start the writer thread: {e}", path.display()))?;
         Ok(McapRecorder {
             path: path.to_path_buf(),
             schemas: HashMap::new(),
