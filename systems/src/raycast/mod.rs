@@ -8,8 +8,9 @@
 //!   space and walk cell by cell only next to obstacles) plus the boundary faces of occupied
 //!   cells per tile. `cast` is one ray, `cast_many` many independent rays advanced in turn so
 //!   their memory loads overlap, and `cast_scan` a whole scan by an angular sweep over the faces
-//!   (front to back, skipping hidden tiles). Results agree with [`cast_dda`]; edits (doors)
-//!   refresh the field and the faces locally.
+//!   (front to back, skipping hidden tiles). Results agree with [`cast_dda`] (single rays to
+//!   millimetres where they graze a wall, see `leap`); edits (doors) refresh the field and the
+//!   faces locally.
 //! - [`overlay_circles`], [`overlay_segments`]: moving obstacles (other robots) drawn into an
 //!   already-cast scan, touching only the beams inside each obstacle's angular interval.
 //!

@@ -10,7 +10,7 @@
 //! around a ray share few cache lines; measured, memory latency — not arithmetic — dominates
 //! random rays on a row-major map.
 
-use super::leap::{Bounds, Lane};
+use super::leap::{Bounds, InCells, Lane};
 use super::sweep::{Faces, TILE as FACE_TILE};
 
 /// Distances are capped, so an edit only changes the field within this many cells.
@@ -231,12 +231,13 @@ impl RayMap {
             Ok(lane) => lane,
             Err(answer) => return answer,
         };
+        let cells = InCells::new(&lane, &b);
         loop {
             let k = self.dist[self.idx(lane.cx as usize, lane.cy as usize)];
             if k == 0 {
                 return lane.t;
             }
-            if !lane.exit_square(k, &b, max_range) {
+            if !lane.exit_square(k, &cells, &b, max_range) {
                 return f32::INFINITY;
             }
         }
