@@ -8,6 +8,14 @@ use std::path::{Path, PathBuf};
 
 const SEC: u64 = samples::SEC;
 
+/// A recorder writing `name` in a fresh temporary folder (kept alive by the returned guard).
+fn recorder(name: &str) -> (tempfile::TempDir, PathBuf, McapRecorder) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    let rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    (dir, path, rec)
+}
+
 fn written(dir: &Path, seconds: u64) -> (PathBuf, Vec<(&'static str, usize)>) {
     let path = dir.join("run.mcap");
     let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
@@ -90,9 +98,7 @@ fn several_channels_read_back_in_time_order() {
 
 #[test]
 fn a_topic_keeps_its_type_and_schemas_are_shared() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("t.mcap");
-    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let (_dir, _, mut rec) = recorder("t.mcap");
     let a = rec.channel::<LaserScan>("/scan").unwrap();
     let b = rec.channel::<LaserScan>("/scan").unwrap();
     let c = rec.channel::<LaserScan>("/scan2").unwrap();
@@ -145,9 +151,7 @@ fn messages_taken_whole_give_the_same_file() {
 
 #[test]
 fn the_flush_period_ends_chunks() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("f.mcap");
-    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let (_dir, _, mut rec) = recorder("f.mcap");
     rec.set_flush_period(Some(SEC));
     let ch = rec.channel::<Range>("/r").unwrap();
     for i in 0..50 {
@@ -159,9 +163,7 @@ fn the_flush_period_ends_chunks() {
 
 #[test]
 fn an_interrupted_writer_leaves_its_flushed_chunks_readable() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("crash.mcap");
-    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let (_dir, path, mut rec) = recorder("crash.mcap");
     rec.set_flush_period(None);
     let scan = rec.channel::<LaserScan>("/scan").unwrap();
     let cam = rec.channel::<Image>("/camera").unwrap();
@@ -192,9 +194,7 @@ fn an_interrupted_writer_leaves_its_flushed_chunks_readable() {
 
 #[test]
 fn a_cut_file_is_an_error_or_recovers_a_prefix() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("small.mcap");
-    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let (_dir, path, mut rec) = recorder("small.mcap");
     rec.set_flush_period(Some(SEC));
     let ch = rec.channel::<Odometry>("/odom").unwrap();
     for i in 0..40 {
@@ -319,9 +319,7 @@ fn a_write_error_is_reported_by_flush_and_by_finish() {
 
 #[test]
 fn channel_ids_run_from_one_and_run_out_with_a_clear_error() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("many.mcap");
-    let mut rec = McapRecorder::create(&path, ROS2_PROFILE).unwrap();
+    let (_dir, path, mut rec) = recorder("many.mcap");
     let first = rec.channel::<Range>("/sonar/0").unwrap();
     let again = rec.channel::<Range>("/sonar/0").unwrap();
     assert_eq!((first.id(), again.id()), (1, 1));
