@@ -53,6 +53,11 @@ fn bench_avoid(c: &mut Criterion) {
     g.bench_function("from_scan", |b| {
         b.iter(|| SectorRanges::from_scan(black_box(&scan), &Pose2::IDENTITY))
     });
+    // what a behaviour does with each new scan: the previous reduction's storage is reused
+    let mut reused = SectorRanges::from_scan(&scan, &Pose2::IDENTITY);
+    g.bench_function("update", |b| {
+        b.iter(|| reused.update(black_box(&scan), &Pose2::IDENTITY))
+    });
     let sectors = SectorRanges::from_scan(&scan, &Pose2::IDENTITY);
     g.bench_function("choose_heading_dead_end", |b| {
         b.iter(|| sectors.choose_heading(black_box(0.0), 0.3, 1.8, PI * 0.8))

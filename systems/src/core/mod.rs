@@ -5,6 +5,7 @@
 pub mod clock;
 pub mod ids;
 pub mod moments;
+pub mod normal;
 pub mod pool;
 pub mod pose;
 pub mod rng;

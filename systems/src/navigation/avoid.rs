@@ -25,30 +25,72 @@ pub struct SectorRanges {
     len: usize,
 }
 
-impl SectorRanges {
-    pub fn from_scan(scan: &LaserScan, mount: &Pose2) -> Self {
-        let mut best = [f32::INFINITY; SECTORS];
-        let mut nearest = [(0f32, 0f32); SECTORS];
-        // beam directions by rotation (no trigonometry per beam); points are binned by beam
-        // angle, while the free-distance test uses their exact coordinates
+/// A scan's beams in the robot's base frame: each beam's direction and sector. It depends only
+/// on the laser's angles and mount, so it is built once and reused for every scan of the same
+/// geometry.
+#[derive(Default)]
+struct BeamSectors {
+    /// angle_min, angle_increment, beam count, mount (x, y, θ) as bits: what the table is for.
+    key: (u32, u32, usize, [u64; 3]),
+    /// cos and sin of each beam's angle in the base frame, and its sector.
+    beams: Vec<(f32, f32, u32)>,
+}
+
+impl BeamSectors {
+    fn key(scan: &LaserScan, mount: &Pose2) -> (u32, u32, usize, [u64; 3]) {
+        (
+            scan.angle_min.to_bits(),
+            scan.angle_increment.to_bits(),
+            scan.ranges.len(),
+            [mount.x.to_bits(), mount.y.to_bits(), mount.theta.to_bits()],
+        )
+    }
+
+    fn build(&mut self, scan: &LaserScan, mount: &Pose2) {
+        self.key = Self::key(scan, mount);
         let a0 = scan.angle_min as f64 + mount.theta;
         let inc = scan.angle_increment as f64;
-        let (si, ci) = inc.sin_cos();
-        let (mut s, mut c) = a0.sin_cos();
-        // the sector index as a running value in [0, SECTORS): no division per beam
-        let n = SECTORS as f64;
-        let mut q = ((a0 / SECTOR_WIDTH) % n + n) % n;
-        let dq = inc / SECTOR_WIDTH;
-        for &r in &scan.ranges {
-            let (sk, ck) = (s, c);
-            (s, c) = (s * ci + c * si, c * ci - s * si);
-            let idx = (q as usize).min(SECTORS - 1);
-            q += dq;
-            if q >= n {
-                q -= n;
-            } else if q < 0.0 {
-                q += n;
+        self.beams = (0..scan.ranges.len())
+            .map(|k| {
+                let a = a0 + k as f64 * inc;
+                let (s, c) = a.sin_cos();
+                let sector = ((a.rem_euclid(2.0 * PI) / SECTOR_WIDTH) as usize).min(SECTORS - 1);
+                (c as f32, s as f32, sector as u32)
+            })
+            .collect();
+    }
+}
+
+thread_local! {
+    /// The beam table of the last scan geometry reduced on this thread (robots with the same
+    /// laser share it).
+    static BEAM_SECTORS: std::cell::RefCell<BeamSectors> =
+        std::cell::RefCell::new(BeamSectors::default());
+}
+
+impl SectorRanges {
+    pub fn from_scan(scan: &LaserScan, mount: &Pose2) -> Self {
+        let mut s = SectorRanges::default();
+        s.update(scan, mount);
+        s
+    }
+
+    /// Reduces `scan` (from a laser at `mount` on the robot) to its nearest point per sector,
+    /// reusing this value's storage.
+    pub fn update(&mut self, scan: &LaserScan, mount: &Pose2) {
+        BEAM_SECTORS.with_borrow_mut(|table| {
+            if table.key != BeamSectors::key(scan, mount) {
+                table.build(scan, mount);
             }
+            self.reduce(scan, mount, table);
+        });
+    }
+
+    fn reduce(&mut self, scan: &LaserScan, mount: &Pose2, table: &BeamSectors) {
+        let mut best = [f32::INFINITY; SECTORS];
+        let mut nearest = [(0f32, 0f32); SECTORS];
+        let (mx, my) = (mount.x as f32, mount.y as f32);
+        for (&r, &(c, s, sector)) in scan.ranges.iter().zip(&table.beams) {
             // a reading below range_min (-Inf) means something very close: treat it as range_min
             let r = if r == f32::NEG_INFINITY {
                 scan.range_min
@@ -58,24 +100,23 @@ impl SectorRanges {
             if !r.is_finite() {
                 continue;
             }
-            let px = (mount.x + ck * r as f64) as f32;
-            let py = (mount.y + sk * r as f64) as f32;
+            let (px, py) = (mx + c * r, my + s * r);
             let d2 = px * px + py * py;
-            if d2 < best[idx] {
-                best[idx] = d2;
-                nearest[idx] = (px, py);
+            let i = sector as usize % SECTORS;
+            if d2 < best[i] {
+                best[i] = d2;
+                nearest[i] = (px, py);
             }
         }
-        let mut xs = Vec::with_capacity(SECTORS + LANES);
-        let mut ys = Vec::with_capacity(SECTORS + LANES);
+        self.xs.clear();
+        self.ys.clear();
         for i in (0..SECTORS).filter(|&i| best[i].is_finite()) {
-            xs.push(nearest[i].0);
-            ys.push(nearest[i].1);
+            self.xs.push(nearest[i].0);
+            self.ys.push(nearest[i].1);
         }
-        let len = xs.len();
-        xs.resize(len.next_multiple_of(LANES), f32::NAN);
-        ys.resize(len.next_multiple_of(LANES), f32::NAN);
-        SectorRanges { xs, ys, len }
+        self.len = self.xs.len();
+        self.xs.resize(self.len.next_multiple_of(LANES), f32::NAN);
+        self.ys.resize(self.len.next_multiple_of(LANES), f32::NAN);
     }
 
     /// The seen points (base frame), in sector order.
@@ -90,7 +131,12 @@ impl SectorRanges {
     /// nearest seen point within the swept band.
     pub fn free_distance(&self, heading: f64, half_width: f64) -> f64 {
         let (uy, ux) = heading.sin_cos();
-        let (ux, uy, hw) = (ux as f32, uy as f32, half_width as f32);
+        self.free_along(ux, uy, half_width as f32) as f64
+    }
+
+    /// [`Self::free_distance`] along the unit vector (ux, uy).
+    fn free_along(&self, ux: f64, uy: f64, hw: f32) -> f32 {
+        let (ux, uy) = (ux as f32, uy as f32);
         // one running minimum per lane (the minimum of a set does not depend on the order)
         let mut free = [f32::INFINITY; LANES];
         for (xs, ys) in self.xs.chunks_exact(LANES).zip(self.ys.chunks_exact(LANES)) {
@@ -103,7 +149,7 @@ impl SectorRanges {
                 free[l] = if d < free[l] { d } else { free[l] };
             }
         }
-        free.into_iter().fold(f32::INFINITY, f32::min) as f64
+        free.into_iter().fold(f32::INFINITY, f32::min)
     }
 
     /// Among headings within ±`max_dev` of `wanted` (steps of 5°), the one closest to `wanted`
@@ -117,14 +163,22 @@ impl SectorRanges {
     ) -> (f64, f64) {
         let step = 5f64.to_radians();
         let n = (max_dev / step).floor() as i32;
-        let mut best_open = (wanted, self.free_distance(wanted, half_width));
+        let hw = half_width as f32;
+        let (uy, ux) = wanted.sin_cos();
+        let mut best_open = (wanted, self.free_along(ux, uy, hw) as f64);
         if best_open.1 >= needed {
             return best_open;
         }
+        // the candidates' directions by rotating the wanted one 5° at a time each way (no
+        // trigonometry per candidate; the rounding after 36 steps is far below a microradian)
+        let (ss, cs) = step.sin_cos();
+        let (mut left, mut right) = ((ux, uy), (ux, uy));
         for k in 1..=n {
-            for sign in [1.0, -1.0] {
+            left = (left.0 * cs - left.1 * ss, left.0 * ss + left.1 * cs);
+            right = (right.0 * cs + right.1 * ss, -right.0 * ss + right.1 * cs);
+            for (sign, (dx, dy)) in [(1.0, left), (-1.0, right)] {
                 let h = wanted + sign * k as f64 * step;
-                let f = self.free_distance(h, half_width);
+                let f = self.free_along(dx, dy, hw) as f64;
                 if f >= needed {
                     return (h, f);
                 }
@@ -163,6 +217,64 @@ mod tests {
             range_max: 30.0,
             ranges,
         }
+    }
+
+    #[test]
+    fn candidate_headings_see_what_free_distance_sees() {
+        // a dead end: every heading within ±100° of ahead is blocked, so the choice steps
+        // through many candidates; the distance it reports must be the one measured directly
+        // walls as (unit normal towards the robot's outside, distance): ahead, left, right
+        let walls = [([1.0, 0.0], 1.0), ([0.0, 1.0], 1.0), ([0.0, -1.0], 1.0)];
+        let ranges = (0..360)
+            .map(|k| {
+                let (s, c) = (-180.0 + k as f64).to_radians().sin_cos();
+                walls
+                    .iter()
+                    .filter_map(|&([nx, ny], d)| {
+                        let towards = c * nx + s * ny;
+                        (towards > 1e-9).then(|| d / towards)
+                    })
+                    .fold(30.0f64, f64::min) as f32
+            })
+            .collect();
+        let scan = LaserScan {
+            stamp: 0.0,
+            angle_min: -PI as f32,
+            angle_increment: 1f32.to_radians(),
+            range_min: 0.05,
+            range_max: 30.0,
+            ranges,
+        };
+        let s = SectorRanges::from_scan(&scan, &Pose2::IDENTITY);
+        for wanted in [0.0, 0.3, -1.0, 2.5] {
+            let (h, f) = s.choose_heading(wanted, 0.3, 5.0, PI * 0.8);
+            let direct = s.free_distance(h, 0.3);
+            assert!((f - direct).abs() < 1e-4, "{wanted}: {h} {f} {direct}");
+        }
+        // the way out of the dead end (behind) is beyond reach: the most open heading wins
+        let (h, f) = s.choose_heading(0.0, 0.3, 50.0, PI * 0.8);
+        let most = (-28..=28)
+            .map(|k| s.free_distance((k as f64 * 5.0).to_radians(), 0.3))
+            .fold(0.0, f64::max);
+        assert!(h.abs() > 2.0 && (f - most).abs() < 1e-4, "{h} {f} {most}");
+    }
+
+    #[test]
+    fn reused_storage_gives_the_same_reduction() {
+        let first = wall_scan(2.0);
+        let second = wall_scan(3.5);
+        let mut reused = SectorRanges::from_scan(&first, &Pose2::IDENTITY);
+        reused.update(&second, &Pose2::IDENTITY);
+        let fresh = SectorRanges::from_scan(&second, &Pose2::IDENTITY);
+        assert_eq!(
+            reused.points().collect::<Vec<_>>(),
+            fresh.points().collect::<Vec<_>>()
+        );
+        // a mounted laser: the points move with the mount
+        let mount = Pose2::new(0.2, 0.0, 0.0);
+        reused.update(&second, &mount);
+        let ahead = reused.free_distance(0.0, 0.3);
+        assert!((ahead - 3.7).abs() < 0.05, "{ahead}");
     }
 
     #[test]

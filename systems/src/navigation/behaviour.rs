@@ -178,7 +178,9 @@ pub fn drive_behaviours(
     pool.for_each(&mut jobs, |(b, belief, kin, cmd, laser)| {
         if let Some((laser, scans)) = laser {
             if let Some(scan) = scans.scans.last() {
-                b.sectors = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+                b.sectors
+                    .get_or_insert_with(SectorRanges::default)
+                    .update(scan, &laser.spec.mount);
             } else if !laser.enabled {
                 b.sectors = None;
             }

@@ -120,7 +120,9 @@ pub fn drive_navigators(
         }
         if let Some((laser, scans)) = laser {
             if let Some(scan) = scans.scans.last() {
-                nav.seen = Some(SectorRanges::from_scan(scan, &laser.spec.mount));
+                nav.seen
+                    .get_or_insert_with(SectorRanges::default)
+                    .update(scan, &laser.spec.mount);
             } else if !laser.enabled {
                 nav.seen = None;
             }

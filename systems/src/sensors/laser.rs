@@ -8,12 +8,12 @@
 use super::others::{NearbyRobots, RobotOutlines};
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;
+use crate::core::normal::fill_standard_normal;
 use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimRng};
 use crate::raycast::{overlay_circles, overlay_segments};
 use crate::world::StaticWorld;
 use bevy_ecs::prelude::*;
 use rand::RngExt;
-use rand_distr::StandardNormal;
 
 /// Laser parameters (SI units, angles in radians).
 #[derive(Clone, Debug, PartialEq)]
@@ -164,28 +164,32 @@ pub struct LaserTruth {
 pub fn apply_noise(spec: &LaserSpec, rng: &mut SimRng, ranges: &mut [f32]) {
     let max = spec.max_range as f32;
     let min = spec.min_range as f32;
+    let (std, dropout) = (spec.noise_std as f32, spec.dropout);
     // draw the same numbers for every beam, whatever it hit, so the stream's use does not
-    // depend on the geometry (which draws are made depends only on the laser's parameters)
-    let (draw_drop, draw_noise) = (spec.dropout > 0.0, spec.noise_std > 0.0);
-    for r in ranges.iter_mut() {
-        let drop: f64 = if draw_drop { rng.random() } else { 1.0 };
-        let n: f64 = if draw_noise {
-            rng.sample(StandardNormal)
-        } else {
-            0.0
-        };
-        if drop < spec.dropout || !r.is_finite() || *r > max {
-            *r = f32::INFINITY;
-            continue;
+    // depend on the geometry (which draws are made depends only on the laser's parameters):
+    // per block of beams, first their deviates, then their dropout draws
+    let (draw_drop, draw_noise) = (dropout > 0.0, spec.noise_std > 0.0);
+    let mut deviates = [0f32; 64];
+    for block in ranges.chunks_mut(deviates.len()) {
+        let noise = &mut deviates[..block.len()];
+        if draw_noise {
+            fill_standard_normal(rng, noise);
         }
-        let noisy = *r + (n * spec.noise_std) as f32;
-        *r = if noisy < min {
-            f32::NEG_INFINITY
-        } else if noisy > max {
-            f32::INFINITY
-        } else {
-            noisy
-        };
+        for (r, &n) in block.iter_mut().zip(noise.iter()) {
+            let drop: f64 = if draw_drop { rng.random() } else { 1.0 };
+            if drop < dropout || !r.is_finite() || *r > max {
+                *r = f32::INFINITY;
+                continue;
+            }
+            let noisy = *r + n * std;
+            *r = if noisy < min {
+                f32::NEG_INFINITY
+            } else if noisy > max {
+                f32::INFINITY
+            } else {
+                noisy
+            };
+        }
     }
 }
 
