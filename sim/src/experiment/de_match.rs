@@ -335,6 +335,26 @@ type PointPair = (Vec<[f32; 2]>, Vec<[f32; 2]>);
 
 /// Runs the experiment and prints the table (or JSON rows).
 pub fn run_de_match_experiment(o: &DeMatchOptions) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let rows = de_match_rows(o)?;
+    if o.json {
+        for r in &rows {
+            println!("{}", serde_json::to_string(r)?);
+        }
+    } else {
+        print!("{}", table(&rows));
+        println!(
+            "right = within 0.1 m and 2° of the true transform; λ_thesis = correlation >= 30 \
+             (the thesis's filter); σ of the right alignments; ms = median wall time per \
+             alignment on one core; {} s in total",
+            started.elapsed().as_secs()
+        );
+    }
+    Ok(())
+}
+
+/// Runs the experiment and returns its rows (progress and `--list-wrong` go to stderr).
+pub fn de_match_rows(o: &DeMatchOptions) -> anyhow::Result<Vec<Row>> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(o.threads)
         .build()
@@ -343,8 +363,7 @@ pub fn run_de_match_experiment(o: &DeMatchOptions) -> anyhow::Result<()> {
     pool.install(|| run_in_pool(o, threads))
 }
 
-fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<()> {
-    let started = Instant::now();
+fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<Vec<Row>> {
     if !o.json {
         eprintln!(
             "capturing scans of {} (one scan per robot every {PERIOD_S} s) ...",
@@ -502,25 +521,11 @@ fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<()> {
             }
         }
     }
-    let rows: Vec<Row> = methods
+    Ok(methods
         .iter()
         .zip(&per_method)
         .map(|(m, res)| summarise(m, protocol, &pairs, &names, res, o.seed))
-        .collect();
-    if o.json {
-        for r in &rows {
-            println!("{}", serde_json::to_string(r)?);
-        }
-    } else {
-        print!("{}", table(&rows));
-        println!(
-            "right = within 0.1 m and 2° of the true transform; λ_thesis = correlation >= 30 \
-             (the thesis's filter); σ of the right alignments; ms = median wall time per \
-             alignment on one core; {} s in total",
-            started.elapsed().as_secs()
-        );
-    }
-    Ok(())
+        .collect())
 }
 
 /// The text table of the rows.

@@ -34,7 +34,7 @@ struct ViolationRuns {
 }
 
 /// Largest gap (m) between successive points of one violation run.
-const RUN_GAP: f32 = 0.25;
+pub(super) const RUN_GAP: f32 = 0.25;
 
 impl ViolationRuns {
     fn new(blob_extent: f32) -> Self {

@@ -13,8 +13,8 @@
 //! * [`de`] — the DE optimizer: nine strategies (eqs. 19–27), two crossovers, selection, stops;
 //! * [`correlation`] — the thesis's raster cross-correlation fitness (eqs. 29, 31, 32);
 //! * [`euclidean`] — the thesis's Euclidean reference fitness (§7.1) and its distance-field form;
-//! * `normals`, `orientation`, `ref_grid`, `translation_search`, `refine`, `subsample`,
-//!   `improved` — the improved matcher's stages (private);
+//! * `movable`, `normals`, `orientation`, `ref_grid`, `translation_search`, `refine`,
+//!   `subsample`, `improved` — the improved matcher's stages (private);
 //! * `matcher` — configuration and the entry point;
 //! * [`prob_grid`] — the probability occupancy grid scan-to-map matchers and SLAM maps share;
 //! * [`map_pyramid`] — its multi-resolution form for Gauss-Newton matching (Hector SLAM, §IV.C);
@@ -39,6 +39,7 @@ mod fast_atan2;
 mod improved;
 mod judge;
 mod matcher;
+mod movable;
 mod normals;
 mod orientation;
 mod ref_grid;

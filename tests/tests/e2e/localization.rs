@@ -379,3 +379,26 @@ fn evo_agrees_with_our_ate_and_rpe() {
     );
     assert!(text.contains("8 passed, 0 failed"), "{text}");
 }
+
+/// `sim experiment de-match --only improved`: the thesis's 460-pair protocol on maze and
+/// hospital scans (steps of 5–30 scans, window ±3 m, ±180°). The improved matcher's target is
+/// λ ≥ 99 %; in the hospital, people walking the corridors must not drag the answer along them.
+#[test]
+fn the_improved_matcher_is_right_on_99_percent_of_the_thesis_pairs() {
+    use sim::experiment::de_match::{DeMatchOptions, de_match_rows};
+    let rows = de_match_rows(&DeMatchOptions {
+        threads: 2,
+        only: Some("improved".to_string()),
+        ..Default::default()
+    })
+    .expect("the experiment runs");
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    let r = &rows[0];
+    eprintln!(
+        "λ {:.1} % of {} (by scenario {:?}, by step {:?})",
+        r.lambda_pct, r.alignments, r.lambda_by_scenario_pct, r.lambda_by_step_pct
+    );
+    assert_eq!(r.alignments, 460);
+    assert!(r.lambda_pct >= 99.0, "{r:?}");
+    assert_eq!(r.lambda_by_scenario_pct["maze_run"], 100.0, "{r:?}");
+}

@@ -52,6 +52,12 @@ pub struct ImprovedConfig {
     /// A run of violating points shorter than this (m) is one moving object and counts once
     /// (0 counts every point).
     pub blob_extent: f32,
+    /// Free-standing compact objects (people, robots) are dropped from both scans before
+    /// matching ([`crate::matching::movable`]): runs of points spanning less than
+    /// `movable_extent` (m; 0 keeps every point) that stand at least `movable_jump` (m) in front
+    /// of the points beside them.
+    pub movable_extent: f32,
+    pub movable_jump: f32,
     /// A refined translation whose least-constrained direction carries less than this share of
     /// the information of the best-constrained one is searched along that direction.
     pub weak_ratio: f64,
@@ -98,6 +104,8 @@ impl Default for ImprovedConfig {
             violation_margin: 0.2,
             violation_weight: 8.0,
             blob_extent: 0.7,
+            movable_extent: 0.7,
+            movable_jump: 0.3,
             weak_ratio: 0.3,
             weak_search: 0.6,
             weak_step: 0.05,
@@ -182,12 +190,18 @@ impl ImprovedConfig {
                 expected: "a finite weight >= 0",
             });
         }
-        if !(self.blob_extent.is_finite() && self.blob_extent >= 0.0) {
-            return Err(MatchError::InvalidParameter {
-                name: "improved.blob_extent",
-                value: self.blob_extent as f64,
-                expected: "a finite length >= 0",
-            });
+        for (name, v) in [
+            ("improved.blob_extent", self.blob_extent),
+            ("improved.movable_extent", self.movable_extent),
+            ("improved.movable_jump", self.movable_jump),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(MatchError::InvalidParameter {
+                    name,
+                    value: v as f64,
+                    expected: "a finite length >= 0",
+                });
+            }
         }
         let count = |name, v: usize, max: usize, expected| {
             if (1..=max).contains(&v) {

@@ -6,6 +6,10 @@
 //! proposed deliberately, translations are searched exhaustively, and candidates are judged
 //! with information the correlation ignores (free space).
 //!
+//! 0. **People set aside** ([`super::movable`]): free-standing compact objects — people,
+//!    robots — are dropped from both scans. They may have moved between the scans, and in a
+//!    corridor lining up a person who walked on outscores the few wall ends that fix the shift
+//!    along it (λ 98.6 → 99.0 % over eight seeds of the 460-pair protocol; seed 0 98.7 → 99.6 %).
 //! 1. **Subsampling** ([`super::subsample`]): both scans thinned to ~5 cm spacing (the near
 //!    range of a scan is 10× denser than needed), a coarser set of the current scan for the
 //!    searches.
@@ -63,7 +67,8 @@ pub use config::ImprovedConfig;
 
 use super::de::{self, Bounds, Vector};
 use super::error::MatchError;
-use super::judge::Judge;
+use super::judge::{Judge, RUN_GAP};
+use super::movable::{Movable, without_movable};
 use super::normals::estimate_normals;
 use super::orientation::{orientation_histogram, rotation_hypotheses};
 use super::ref_grid::{MAX_INDEXED, NearestGrid, ScoreGrid};
@@ -72,6 +77,11 @@ use super::subsample::subsample;
 use super::translation_search::{Shift, best_shifts};
 use super::visibility::RangeImage;
 use crate::core::{SimRng, wrap_angle};
+use std::borrow::Cow;
+
+/// Fewest points a scan keeps when its free-standing objects are dropped (otherwise it is
+/// matched whole).
+const MIN_KEPT: usize = 20;
 
 /// The outcome of [`match_improved`].
 pub(crate) struct ImprovedOutcome {
@@ -141,6 +151,21 @@ pub(crate) fn match_improved(
 ) -> Result<ImprovedOutcome, MatchError> {
     cfg.validate()?;
     bounds.validate()?;
+    // 0. people and robots set aside: they may have moved between the scans
+    let (reference, current) = if cfg.movable_extent > 0.0 {
+        let m = Movable {
+            gap: RUN_GAP,
+            extent: cfg.movable_extent,
+            jump: cfg.movable_jump,
+        };
+        (
+            Cow::Owned(without_movable(reference, &m, MIN_KEPT)),
+            Cow::Owned(without_movable(current, &m, MIN_KEPT)),
+        )
+    } else {
+        (Cow::Borrowed(reference), Cow::Borrowed(current))
+    };
+    let (reference, current) = (&reference[..], &current[..]);
     // normals from neighbours within 0.5 m, or within 3.5 point spacings up to 1.5 m where a
     // wall is sampled sparsely (far away, grazing)
     let (normal_gate, normal_max_gate) = (0.5, 1.5);
