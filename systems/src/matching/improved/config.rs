@@ -64,7 +64,7 @@ pub struct ImprovedConfig {
     /// Half-length (m) and step (m) of that line search.
     pub weak_search: f32,
     pub weak_step: f32,
-    /// The best local maxima of the inlier count along that line (other than the refined
+    /// The best local maxima of the judged score along that line (other than the refined
     /// answer itself) that are refined again and judged.
     pub weak_peaks: usize,
     /// Run the rotation polish when the winner's inlier fraction of the fine set is below this

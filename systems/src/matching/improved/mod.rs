@@ -39,9 +39,11 @@
 //!    shifts that line the two scans' samples up win, 0.1–0.2 m along a corridor.
 //!
 //!    **Corridor line search**: where the refined translation is weakly constrained (a
-//!    corridor), the inlier count is scanned along the weak direction (±`weak_search`); its
+//!    corridor), the judged score is scanned along the weak direction (±`weak_search`); its
 //!    best `weak_peaks` local maxima are refined again and judged, and the best judged answer
-//!    is kept.
+//!    is kept. (Scanning the inlier count instead missed shifts whose advantage is fewer
+//!    free-space violations: λ 99.04 → 99.20 % over seeds 0–7, 98.82 → 98.90 % over 8–15, for
+//!    0.25 ms more per alignment.)
 //!
 //!    **Rotation polish**: when the winner explains less than `polish_below` of the fine set
 //!    (little overlap, e.g. 30 steps apart), the wide starting gate lets the refinement pull the
@@ -124,20 +126,26 @@ fn pick_finalists(screened: &[(Vector, f64)], n: usize, extra_rotations: usize) 
     picked
 }
 
-/// Indices of the best `n` strict local maxima of `counts` (a maximum's right neighbour is
-/// lower, its left one not higher; `None` is outside the window), most inliers first, then
-/// nearest the middle; the middle itself (the refined answer) is left out.
-fn line_peaks(counts: &[Option<usize>], n: usize) -> Vec<i32> {
-    let mid = (counts.len() / 2) as i32;
-    let mut peaks: Vec<(usize, i32)> = (0..counts.len())
+/// Indices of the best `n` strict local maxima of `scores` (a maximum's right neighbour is
+/// lower, its left one not higher; `None` is outside the window and lower than any score),
+/// best first, then nearest the middle; the middle itself (the refined answer) is left out.
+fn line_peaks(scores: &[Option<f64>], n: usize) -> Vec<i32> {
+    let mid = (scores.len() / 2) as i32;
+    let at = |j: Option<usize>| {
+        j.and_then(|j| scores.get(j).copied().flatten())
+            .unwrap_or(f64::NEG_INFINITY)
+    };
+    let mut peaks: Vec<(f64, i32)> = (0..scores.len())
         .filter_map(|i| {
-            let c = counts[i]?;
-            let left = i.checked_sub(1).and_then(|j| counts[j]).unwrap_or(0);
-            let right = counts.get(i + 1).copied().flatten().unwrap_or(0);
+            let c = scores[i]?;
+            let (left, right) = (at(i.checked_sub(1)), at(Some(i + 1)));
             (i as i32 != mid && c >= left && c > right).then_some((c, i as i32))
         })
         .collect();
-    peaks.sort_by_key(|&(c, i)| (std::cmp::Reverse(c), (i - mid).abs()));
+    peaks.sort_by(|a, b| {
+        b.0.total_cmp(&a.0)
+            .then((a.1 - mid).abs().cmp(&(b.1 - mid).abs()))
+    });
     peaks.into_iter().take(n).map(|(_, i)| i).collect()
 }
 
@@ -291,14 +299,16 @@ pub(crate) fn match_improved(
                 let o = k as f64 * cfg.weak_step as f64;
                 [origin[0] + o * d[0], origin[1] + o * d[1], origin[2]]
             };
-            let counts: Vec<Option<usize>> = (-steps..=steps)
+            let scores: Vec<Option<f64>> = (-steps..=steps)
                 .map(|k| {
                     let t = at(k);
-                    bounds.contains(&t).then(|| judge.inliers(&cur_fine, &t))
+                    bounds
+                        .contains(&t)
+                        .then(|| judge.score(&cur_fine, &ref_fine, &t).0)
                 })
                 .collect();
             let mut best_score = judge.score(&cur_fine, &ref_fine, &r).0;
-            for k in line_peaks(&counts, cfg.weak_peaks) {
+            for k in line_peaks(&scores, cfg.weak_peaks) {
                 let t = at(k - steps);
                 let again = keep_inside(refine(&judge.model, &cur_fine, t, &full).x, t);
                 let score = judge.score(&cur_fine, &ref_fine, &again).0;
@@ -417,7 +427,7 @@ mod tests {
     fn line_peaks_are_the_best_local_maxima_other_than_the_middle() {
         // middle index 4 (the refined answer) is a maximum but left out; 9 at index 7 beats
         // the plateau 7, 7 at 1–2 (its right end is the maximum); None is outside the window
-        let counts = [
+        let counts = judged(&[
             Some(3),
             Some(7),
             Some(7),
@@ -427,11 +437,11 @@ mod tests {
             Some(5),
             Some(9),
             None,
-        ];
+        ]);
         assert_eq!(line_peaks(&counts, 5), vec![7, 2]);
         assert_eq!(line_peaks(&counts, 1), vec![7]);
         // equal peaks: the nearer to the middle first
-        let even = [
+        let even = judged(&[
             Some(6),
             Some(1),
             Some(1),
@@ -439,9 +449,9 @@ mod tests {
             Some(0),
             Some(1),
             Some(6),
-        ];
+        ]);
         assert_eq!(line_peaks(&even, 2), vec![0, 6]);
-        let near = [
+        let near = judged(&[
             Some(6),
             Some(1),
             Some(6),
@@ -449,8 +459,15 @@ mod tests {
             Some(0),
             Some(1),
             Some(1),
-        ];
+        ]);
         assert_eq!(line_peaks(&near, 1), vec![2]);
-        assert!(line_peaks(&[None, Some(3), None], 2).is_empty());
+        assert!(line_peaks(&[None, Some(3.0), None], 2).is_empty());
+        // judged scores may be negative: a window edge (None) is lower still
+        let negative = judged(&[Some(-5), Some(-9), Some(-9), Some(-9), None]);
+        assert_eq!(line_peaks(&negative, 3), vec![0, 3]);
+    }
+
+    fn judged(v: &[Option<i32>]) -> Vec<Option<f64>> {
+        v.iter().map(|x| x.map(f64::from)).collect()
     }
 }
