@@ -108,7 +108,7 @@ impl Default for ImprovedConfig {
             movable_jump: 0.3,
             weak_ratio: 0.3,
             weak_search: 0.6,
-            weak_step: 0.05,
+            weak_step: 0.1,
             weak_peaks: 1,
             polish_below: 0.5,
             polish_gate: 0.15,
