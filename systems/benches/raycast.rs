@@ -1,6 +1,7 @@
 //! Ray-casting kernels on the hospital map (and tiled 4 × 4): random single rays and whole scans
-//! from random free poses, 20 m rays, against the plain DDA baseline; scans also ray by ray
-//! (`raymap_rays`: the distance-field walk the sweep replaces). Throughput is rays/s.
+//! from random free poses, 20 m rays (and Stage's 180-beam 8 m ranger), against the plain DDA
+//! baseline; scans also ray by ray (`raymap_rays`: the distance-field walk the sweep replaces).
+//! Throughput is rays/s.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use rand::RngExt;
@@ -97,8 +98,12 @@ fn bench(c: &mut Criterion) {
     }
     g.finish();
 
-    for (beams, fov, range) in [(1081usize, 270f32, 20f32), (180, 180.0, 8.0)] {
-        let mut g = c.benchmark_group(format!("scans_{beams}_beams"));
+    for (beams, fov, range) in [
+        (1081usize, 270f32, 20f32),
+        (180, 180.0, 8.0),
+        (180, 180.0, 20.0),
+    ] {
+        let mut g = c.benchmark_group(format!("scans_{beams}_beams_{range}m"));
         let n_scans = 256;
         g.throughput(Throughput::Elements((n_scans * beams) as u64));
         let inc = fov.to_radians() / (beams - 1) as f32;
