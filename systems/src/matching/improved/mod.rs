@@ -415,6 +415,20 @@ mod tests {
                     ..ImprovedConfig::default()
                 },
             ),
+            (
+                "improved.movable_extent",
+                ImprovedConfig {
+                    movable_extent: -0.7,
+                    ..ImprovedConfig::default()
+                },
+            ),
+            (
+                "improved.movable_jump",
+                ImprovedConfig {
+                    movable_jump: f32::INFINITY,
+                    ..ImprovedConfig::default()
+                },
+            ),
         ] {
             match cfg.validate() {
                 Err(MatchError::InvalidParameter { name, .. }) => assert_eq!(name, field),
