@@ -79,8 +79,9 @@ impl ViolationRuns {
     }
 }
 
+/// Squared distance of two points.
 #[inline(always)]
-fn dist2(a: [f32; 2], b: [f32; 2]) -> f32 {
+pub(super) fn dist2(a: [f32; 2], b: [f32; 2]) -> f32 {
     (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1])
 }
 

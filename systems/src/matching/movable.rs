@@ -10,6 +10,8 @@
 //! in front of the points just before and after it. A static pillar of that size is dropped
 //! too — the price of not knowing which objects move.
 
+use super::judge::dist2;
+
 /// What counts as a free-standing object.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Movable {
@@ -27,14 +29,13 @@ pub(crate) fn free_standing(points: &[[f32; 2]], m: &Movable) -> Vec<bool> {
     let n = points.len();
     let mut out = vec![false; n];
     let range = |p: [f32; 2]| p[0].hypot(p[1]);
-    let d2 = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
     let mut i = 0;
     while i < n {
         let mut j = i;
-        while j + 1 < n && d2(points[j], points[j + 1]) <= m.gap * m.gap {
+        while j + 1 < n && dist2(points[j], points[j + 1]) <= m.gap * m.gap {
             j += 1;
         }
-        if i > 0 && j + 1 < n && d2(points[i], points[j]) < m.extent * m.extent {
+        if i > 0 && j + 1 < n && dist2(points[i], points[j]) < m.extent * m.extent {
             let farthest = points[i..=j]
                 .iter()
                 .map(|&p| range(p))
