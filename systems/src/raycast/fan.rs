@@ -71,14 +71,6 @@ impl Fan {
         };
         [one(rel), second]
     }
-
-    /// Calls `f(k)` for every beam index whose angle lies in the arc [lo, lo + width].
-    #[inline]
-    pub fn for_each_in(&self, lo: f32, width: f32, mut f: impl FnMut(usize)) {
-        for (k0, k1) in self.ranges(lo, width).into_iter().flatten() {
-            (k0..=k1).for_each(&mut f);
-        }
-    }
 }
 
 #[cfg(test)]
@@ -104,8 +96,6 @@ mod tests {
         assert_eq!(r.into_iter().flatten().collect::<Vec<_>>(), vec![(0, 2)]);
         // no beams, no ranges
         assert_eq!(Fan::new(0.0, 0.1, 0).ranges(0.0, 1.0), [None, None]);
-        let mut seen = Vec::new();
-        fan.for_each_in(deg(-1.5), deg(2.0), |k| seen.push(k));
-        assert_eq!(seen, vec![179, 180]);
+        assert_eq!(fan.ranges(deg(-1.5), deg(2.0)), [Some((179, 180)), None]);
     }
 }

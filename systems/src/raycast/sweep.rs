@@ -1,42 +1,84 @@
-//! Whole scans by angular rasterisation ("z-buffering" in polar coordinates): the boundary faces
-//! of occupied cells are precomputed per 16 × 16-cell tile (merged along straight runs); a scan
-//! visits 4 × 4 groups of tiles (super tiles) within range front to back, skips groups and then
-//! tiles that the beams already hitting nearer cannot see past (tested against per-block maxima
-//! of the ranges so far, 16 beams a block), culls back faces, maps each face to the beam indices
-//! it subtends and keeps, per beam, the nearest exact ray–face intersection. The first occupied cell a ray enters
-//! is entered through such a face, so results agree with the cell walk of [`super::cast_dda`].
-//! Cost grows with the faces actually visible, not with the length of the rays.
+//! Whole scans by angular rasterisation ("z-buffering" in polar coordinates). The boundary faces
+//! of occupied cells are precomputed per 64 × 64-cell tile, merged along straight runs, grouped by
+//! the side they face and sorted by position. A scan visits the tiles within range front to back
+//! and skips those that the beams already hitting nearer cannot see past (tested against per-block
+//! maxima of the ranges so far, 16 beams a block). In a visited tile the faces turned towards the
+//! sensor are a prefix or suffix of each group; each is mapped to the beam indices it subtends
+//! (a whole group at once, branch-free so it vectorises) and every beam keeps the nearest exact
+//! ray–face intersection. The first occupied cell a ray enters is entered through such a face, so
+//! results agree with the cell walk of [`super::cast_dda`]. Cost grows with the faces actually
+//! visible, not with the length of the rays.
 
 use super::fan::Fan;
+use std::f32::consts::TAU;
 
-pub(crate) const TILE: usize = 16;
-/// Tiles per side of a super tile: empty or hidden regions are skipped 4 × 4 tiles at a time.
-const SUPER: usize = 4;
-/// Offsets are tabulated to this many super tiles (64 × 16 × SUPER cells, 205 m at 5 cm).
-const SUPER_RADIUS: i32 = 64;
+/// Cells per side of a tile. Faces are merged along straight runs within a tile, and a tile is
+/// the unit of the occlusion test: measured on the hospital (random poses, 20 m), 64 beat 32 and
+/// 128 for 180- and 1081-beam scans, and a second level of 16-cell tiles inside did not pay for
+/// its occlusion tests.
+pub(crate) const TILE: usize = 64;
+/// Offsets are tabulated to this many tiles (64 × 64 cells, 205 m at 5 cm).
+const RADIUS: i32 = 64;
 
-/// atan2 by a minimax polynomial (max error about 1e-5 rad): beam ranges are taken with a 1e-4
-/// rad margin and every hit is then computed exactly, so the approximation never changes a range.
+/// atan2 by a minimax polynomial (max error about 1e-5 rad), without branches so that loops
+/// over faces vectorise: intervals are taken with a [`MARGIN`] and every hit is then computed
+/// exactly, so the approximation never changes a range. atan2(0, 0) = 0.
 #[inline]
-fn fast_atan2(y: f32, x: f32) -> f32 {
+fn atan2_approx(y: f32, x: f32) -> f32 {
     use std::f32::consts::{FRAC_PI_2, PI};
     let (ax, ay) = (x.abs(), y.abs());
-    let (mn, mx) = if ax < ay { (ax, ay) } else { (ay, ax) };
-    if mx == 0.0 {
-        return 0.0;
-    }
-    let a = mn / mx;
+    let (mn, mx) = (ax.min(ay), ax.max(ay));
+    let a = mn / mx.max(f32::MIN_POSITIVE);
     let s = a * a;
     let mut r =
         a * (0.999_866 + s * (-0.330_299_5 + s * (0.180_141 + s * (-0.085_133 + s * 0.020_835_1))));
-    if ay > ax {
-        r = FRAC_PI_2 - r;
-    }
-    if x < 0.0 {
-        r = PI - r;
-    }
+    r = if ay > ax { FRAC_PI_2 - r } else { r };
+    r = if x < 0.0 { PI - r } else { r };
     if y < 0.0 { -r } else { r }
 }
+
+/// Beam k's direction (dx, dy) and the reciprocals (1/dx, 1/dy) into `dirs[k]`, for beams at
+/// `start + k·inc`: four interleaved rotation recurrences (by 4·inc, so they do not wait on each
+/// other), re-anchored on sin/cos every 64 beams.
+fn beam_dirs(start: f32, inc: f32, dirs: &mut [[f32; 4]]) {
+    let (si, ci) = inc.sin_cos();
+    let (s4, c4) = (4.0 * inc).sin_cos();
+    for (c, chunk) in dirs.chunks_mut(64).enumerate() {
+        let (mut xs, mut ys) = ([0.0f32; 4], [0.0f32; 4]);
+        (ys[0], xs[0]) = (start + (c * 64) as f32 * inc).sin_cos();
+        for i in 1..4 {
+            xs[i] = xs[i - 1] * ci - ys[i - 1] * si;
+            ys[i] = xs[i - 1] * si + ys[i - 1] * ci;
+        }
+        for quad in chunk.chunks_mut(4) {
+            for ((d, &dx), &dy) in quad.iter_mut().zip(&xs).zip(&ys) {
+                // one division for both reciprocals, unless a component is (nearly) zero
+                let p = dx * dy;
+                *d = if p.abs() > 1e-12 {
+                    let r = 1.0 / p;
+                    [dx, dy, dy * r, dx * r]
+                } else {
+                    let recip = |v: f32| {
+                        if v.abs() < 1e-12 {
+                            f32::INFINITY
+                        } else {
+                            1.0 / v
+                        }
+                    };
+                    [dx, dy, recip(dx), recip(dy)]
+                };
+            }
+            for i in 0..4 {
+                let nx = xs[i] * c4 - ys[i] * s4;
+                ys[i] = xs[i] * s4 + ys[i] * c4;
+                xs[i] = nx;
+            }
+        }
+    }
+}
+
+/// Margin of a face's angular interval (radians): wider than the error of [`atan2_approx`].
+const MARGIN: f32 = 1e-4;
 
 /// Beams per block of the occlusion maxima.
 const BLOCK: usize = 16;
@@ -48,6 +90,7 @@ const BLOCK: usize = 16;
 struct Scratch {
     dirs: Vec<[f32; 4]>,
     bmax: Vec<f32>,
+    spans: Vec<[i32; 3]>,
 }
 
 thread_local! {
@@ -80,7 +123,6 @@ fn visible(
     cx: f32,
     cy: f32,
     half_diag: f32,
-    inc: f32,
     horizon: f32,
 ) -> bool {
     let dist = (cx * cx + cy * cy).sqrt();
@@ -91,52 +133,42 @@ fn visible(
     if dist <= half_diag * 1.05 {
         return true;
     }
-    // asin(x) ≤ x·π/2 on [0, 1]: a slightly wide, never narrow, interval
-    let half = (half_diag / dist).min(1.0) * std::f32::consts::FRAC_PI_2 + inc;
-    let lo = fast_atan2(cy, cx) - half;
+    // the region lies within the circle of radius half_diag, which subtends ±asin(x), x < 1/1.05;
+    // asin(x) ≤ tan(asin(x)) = x / √(1 − x²): a slightly wide, never narrow, interval
+    let x = half_diag / dist;
+    let half = x / (1.0 - x * x).sqrt() + MARGIN;
+    let lo = atan2_approx(cy, cx) - half;
     any_beyond(fan, out, bmax, lo, 2.0 * half, near)
 }
 
-/// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`.
+/// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`
+/// (the axis and the side it faces are those of the group it is stored in, see [`Tile`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Face {
     at: f32,
     lo: f32,
     hi: f32,
-    /// 0: x = at, facing +x; 1: facing −x; 2: y = at, facing +y; 3: facing −y.
-    kind: u8,
 }
 
-/// Tiles in a super tile.
-const SUPER_TILES: usize = SUPER * SUPER;
+/// The four facings: 0: x = at, facing +x; 1: facing −x; 2: y = at, facing +y; 3: facing −y.
+const FACINGS: usize = 4;
 
-/// The faces of the SUPER × SUPER tiles of one super tile in one array, tile after tile (row
-/// major), so a scan reading a super tile touches one allocation: on a large map, chasing a
-/// separate allocation per tile cost cache misses on most visited tiles.
+/// The faces of one tile, grouped by facing and sorted by `at` within a group, so the faces that
+/// face the sensor are a prefix (facing +) or suffix (facing −) of their group: back faces cost
+/// nothing and the loops have no unpredictable branch.
 #[derive(Clone, Default)]
-struct SuperTile {
+struct Tile {
     faces: Vec<Face>,
-    /// Faces of local tile l are `faces[starts[l]..starts[l + 1]]` (a 64 × 64-cell super tile
-    /// has at most 4 · 64 · 64 faces).
-    starts: [u16; SUPER_TILES + 1],
-}
-
-impl SuperTile {
-    #[inline]
-    fn tile(&self, l: usize) -> &[Face] {
-        &self.faces[self.starts[l] as usize..self.starts[l + 1] as usize]
-    }
+    /// Faces of facing j are `faces[groups[j]..groups[j + 1]]`.
+    groups: [u32; FACINGS + 1],
 }
 
 pub(crate) struct Faces {
     tw: usize,
     th: usize,
     res: f32,
-    /// Super tiles per row and column, and their faces.
-    sw: usize,
-    sh: usize,
-    supers: Vec<SuperTile>,
-    /// Super-tile offsets sorted by distance (for front-to-back visits).
+    tiles: Vec<Tile>,
+    /// Tile offsets sorted by distance (for front-to-back visits).
     offsets: Vec<(i16, i16, f32)>,
 }
 
@@ -144,14 +176,11 @@ impl Faces {
     pub fn new(w: usize, h: usize, res: f32, occ: &dyn Fn(i64, i64) -> bool) -> Faces {
         let tw = w.div_ceil(TILE).max(1);
         let th = h.div_ceil(TILE).max(1);
-        let (sw, sh) = (tw.div_ceil(SUPER), th.div_ceil(SUPER));
         let mut f = Faces {
             tw,
             th,
             res,
-            sw,
-            sh,
-            supers: vec![SuperTile::default(); sw * sh],
+            tiles: vec![Tile::default(); tw * th],
             offsets: Vec::new(),
         };
         for ty in 0..th {
@@ -159,8 +188,8 @@ impl Faces {
                 f.rebuild_tile(tx, ty, w, h, occ);
             }
         }
-        let r = SUPER_RADIUS;
-        let size = (SUPER * TILE) as f32 * res;
+        let r = RADIUS;
+        let size = TILE as f32 * res;
         for dy in -r..=r {
             for dx in -r..=r {
                 let d = ((dx * dx + dy * dy) as f32).sqrt() * size;
@@ -171,10 +200,10 @@ impl Faces {
         f
     }
 
-    /// The longest range a sweep handles: every super tile that can hold a point within it
-    /// (centre up to range + one super-tile diagonal away) must be in the offset table.
+    /// The longest range a sweep handles: every tile that can hold a point within it (centre
+    /// up to range + one tile diagonal away) must be in the offset table.
     pub fn reach(&self) -> f32 {
-        (SUPER_RADIUS - 2) as f32 * (SUPER * TILE) as f32 * self.res
+        (RADIUS - 2) as f32 * TILE as f32 * self.res
     }
 
     /// Re-extracts the faces of the occupied cells of one tile.
@@ -192,10 +221,10 @@ impl Faces {
             ((tx + 1) * TILE).min(w) as i64,
             ((ty + 1) * TILE).min(h) as i64,
         );
-        let mut faces = Vec::new();
+        let mut groups: [Vec<Face>; FACINGS] = Default::default();
         // vertical faces: for each column boundary side, runs along y
         for c in c0..c1 {
-            for (kind, nc) in [(0u8, c + 1), (1u8, c - 1)] {
+            for (kind, nc) in [(0usize, c + 1), (1, c - 1)] {
                 let mut run: Option<i64> = None;
                 for r in r0..=r1 {
                     let on = r < r1 && occ(c, r) && !occ(nc, r);
@@ -203,11 +232,10 @@ impl Faces {
                         (true, None) => run = Some(r),
                         (false, Some(s)) => {
                             let x = if kind == 0 { c + 1 } else { c } as f32 * res;
-                            faces.push(Face {
+                            groups[kind].push(Face {
                                 at: x,
                                 lo: s as f32 * res,
                                 hi: r as f32 * res,
-                                kind,
                             });
                             run = None;
                         }
@@ -217,7 +245,7 @@ impl Faces {
             }
         }
         for r in r0..r1 {
-            for (kind, nr) in [(2u8, r + 1), (3u8, r - 1)] {
+            for (kind, nr) in [(2usize, r + 1), (3, r - 1)] {
                 let mut run: Option<i64> = None;
                 for c in c0..=c1 {
                     let on = c < c1 && occ(c, r) && !occ(c, nr);
@@ -225,11 +253,10 @@ impl Faces {
                         (true, None) => run = Some(c),
                         (false, Some(s)) => {
                             let y = if kind == 2 { r + 1 } else { r } as f32 * res;
-                            faces.push(Face {
+                            groups[kind].push(Face {
                                 at: y,
                                 lo: s as f32 * res,
                                 hi: c as f32 * res,
-                                kind,
                             });
                             run = None;
                         }
@@ -238,15 +265,14 @@ impl Faces {
                 }
             }
         }
-        let st = &mut self.supers[(ty / SUPER) * self.sw + tx / SUPER];
-        let l = (ty % SUPER) * SUPER + tx % SUPER;
-        let (a, b) = (st.starts[l] as usize, st.starts[l + 1] as usize);
-        let added = faces.len();
-        st.faces.splice(a..b, faces);
-        for s in &mut st.starts[l + 1..] {
-            *s = (*s as usize + added - (b - a)) as u16;
+        let tile = &mut self.tiles[ty * self.tw + tx];
+        tile.faces.clear();
+        for (j, g) in groups.iter_mut().enumerate() {
+            g.sort_by(|a, b| a.at.total_cmp(&b.at));
+            tile.groups[j] = tile.faces.len() as u32;
+            tile.faces.extend_from_slice(g);
         }
-        debug_assert!(st.faces.len() <= u16::MAX as usize);
+        tile.groups[FACINGS] = tile.faces.len() as u32;
     }
 
     pub fn tile_counts(&self) -> (usize, usize) {
@@ -254,11 +280,11 @@ impl Faces {
     }
 
     pub fn memory_bytes(&self) -> usize {
-        self.supers
+        self.tiles
             .iter()
             .map(|t| t.faces.capacity() * std::mem::size_of::<Face>())
             .sum::<usize>()
-            + self.supers.len() * std::mem::size_of::<SuperTile>()
+            + self.tiles.len() * std::mem::size_of::<Tile>()
             + self.offsets.len() * 8
     }
 
@@ -285,107 +311,71 @@ impl Faces {
             return;
         }
         let fan = Fan::new(start, inc, n);
-        let Scratch { dirs, bmax } = scratch;
+        let Scratch { dirs, bmax, spans } = scratch;
         bmax.clear();
         bmax.resize(n.div_ceil(BLOCK), f32::INFINITY);
-        // beam directions by rotation, re-anchored every 64 beams
-        dirs.clear();
-        let (si, ci) = inc.sin_cos();
-        let (mut dy, mut dx) = (0.0f32, 1.0f32);
-        let recip = |d: f32| {
-            if d.abs() < 1e-12 {
-                f32::INFINITY
-            } else {
-                1.0 / d
-            }
-        };
-        for k in 0..n {
-            if k % 64 == 0 {
-                (dy, dx) = (start + k as f32 * inc).sin_cos();
-            }
-            dirs.push([dx, dy, recip(dx), recip(dy)]);
-            let nx = dx * ci - dy * si;
-            dy = dx * si + dy * ci;
-            dx = nx;
-        }
+        dirs.resize(n, [0.0; 4]);
+        beam_dirs(start, inc, dirs);
         let tsize = TILE as f32 * self.res;
-        let ssize = SUPER as f32 * tsize;
         let half_diag = tsize * std::f32::consts::FRAC_1_SQRT_2;
-        let super_half_diag = ssize * std::f32::consts::FRAC_1_SQRT_2;
-        let (psx, psy) = ((gx / ssize) as i32, (gy / ssize) as i32);
+        let (ptx, pty) = ((gx / tsize) as i32, (gy / tsize) as i32);
+        let beams = Beams {
+            gx,
+            gy,
+            start: super::fan::wrap_tau(start),
+            inv_inc: 1.0 / inc,
+            n,
+        };
         // a scan of at most 180° sees nothing wholly behind the line through the sensor across
         // its central direction
         let (my, mx) = (start + fan.span() / 2.0).sin_cos();
         let half_plane = fan.span() <= std::f32::consts::PI + 1e-6;
-        let behind = |cx: f32, cy: f32, hd: f32| half_plane && cx * mx + cy * my < -hd;
-        // super tiles are visited front to back: once every beam has hit something nearer than
-        // the next ones, the scan is complete
+        // tiles are visited front to back: once every beam has hit something nearer than the
+        // next ones, the scan is complete
         let mut horizon = max_range;
         for &(ox, oy, d) in &self.offsets {
-            if d - 2.0 * super_half_diag > horizon {
+            if d - 2.0 * half_diag > horizon {
                 break;
             }
-            let (sx, sy) = (psx + ox as i32, psy + oy as i32);
-            if sx < 0 || sy < 0 || sx >= self.sw as i32 || sy >= self.sh as i32 {
+            let (tx, ty) = (ptx + ox as i32, pty + oy as i32);
+            if tx < 0 || ty < 0 || tx >= self.tw as i32 || ty >= self.th as i32 {
                 continue;
             }
-            let st = &self.supers[sy as usize * self.sw + sx as usize];
-            if st.faces.is_empty() {
+            let tile = &self.tiles[ty as usize * self.tw + tx as usize];
+            if tile.faces.is_empty() {
                 continue;
             }
-            let cx = (sx as f32 + 0.5) * ssize - gx;
-            let cy = (sy as f32 + 0.5) * ssize - gy;
-            if behind(cx, cy, super_half_diag) {
+            let cx = (tx as f32 + 0.5) * tsize - gx;
+            let cy = (ty as f32 + 0.5) * tsize - gy;
+            if half_plane && cx * mx + cy * my < -half_diag {
                 continue;
             }
-            if !visible(&fan, out, bmax, cx, cy, super_half_diag, inc, horizon) {
+            if !visible(&fan, out, bmax, cx, cy, half_diag, horizon) {
                 continue;
             }
-            // its tiles, nearest corner first (the order only makes occlusion more effective)
-            let (x0, y0) = (sx as usize * SUPER, sy as usize * SUPER);
-            for j in 0..SUPER {
-                let ty = if cy >= 0.0 {
-                    y0 + j
+            let (mut k0, mut k1) = (usize::MAX, 0);
+            let group =
+                |j: usize| &tile.faces[tile.groups[j] as usize..tile.groups[j + 1] as usize];
+            // front faces: x = at facing +x when at < gx, facing −x when at > gx (y alike)
+            let front = |j: usize, g: f32| {
+                let f = group(j);
+                if j == 0 || j == 2 {
+                    &f[..f.partition_point(|f| f.at < g)]
                 } else {
-                    y0 + SUPER - 1 - j
-                };
-                if ty >= self.th {
-                    continue;
+                    &f[f.partition_point(|f| f.at <= g)..]
                 }
-                for i in 0..SUPER {
-                    let tx = if cx >= 0.0 {
-                        x0 + i
-                    } else {
-                        x0 + SUPER - 1 - i
-                    };
-                    if tx >= self.tw {
-                        continue;
-                    }
-                    let faces = st.tile((ty - y0) * SUPER + tx - x0);
-                    if faces.is_empty() {
-                        continue;
-                    }
-                    let tcx = (tx as f32 + 0.5) * tsize - gx;
-                    let tcy = (ty as f32 + 0.5) * tsize - gy;
-                    if behind(tcx, tcy, half_diag) {
-                        continue;
-                    }
-                    if !visible(&fan, out, bmax, tcx, tcy, half_diag, inc, horizon) {
-                        continue;
-                    }
-                    let (mut k0, mut k1) = (usize::MAX, 0);
-                    for f in faces {
-                        self.draw_face(f, gx, gy, &fan, dirs, out, &mut k0, &mut k1);
-                    }
-                    if k0 <= k1 {
-                        // the touched beams' blocks get exact bounds again
-                        for b in k0 / BLOCK..=k1 / BLOCK {
-                            let end = (b * BLOCK + BLOCK).min(n);
-                            bmax[b] = out[b * BLOCK..end].iter().fold(0.0f32, |m, &x| m.max(x));
-                        }
-                        horizon = bmax.iter().fold(0.0f32, |m, &r| m.max(r)).min(max_range);
-                    }
+            };
+            beams.draw::<0>(front(0, gx), spans, dirs, out, &mut k0, &mut k1);
+            beams.draw::<1>(front(1, gx), spans, dirs, out, &mut k0, &mut k1);
+            beams.draw::<2>(front(2, gy), spans, dirs, out, &mut k0, &mut k1);
+            beams.draw::<3>(front(3, gy), spans, dirs, out, &mut k0, &mut k1);
+            if k0 <= k1 {
+                // the touched beams' blocks get exact bounds again
+                for b in k0 / BLOCK..=k1 / BLOCK {
+                    let end = (b * BLOCK + BLOCK).min(n);
+                    bmax[b] = out[b * BLOCK..end].iter().fold(0.0f32, |m, &x| m.max(x));
                 }
+                horizon = bmax.iter().fold(0.0f32, |m, &r| m.max(r)).min(max_range);
             }
         }
         for o in out.iter_mut() {
@@ -394,58 +384,91 @@ impl Faces {
             }
         }
     }
+}
 
-    /// Intersects one face with the beams it subtends, keeping the nearest hit per beam; the
-    /// indices of beams it shortened widen [k0, k1].
+/// What drawing a face needs of the scan: the sensor (grid-relative), the fan's first angle in
+/// [0, 2π) and the reciprocal of its increment, the number of beams.
+struct Beams {
+    gx: f32,
+    gy: f32,
+    start: f32,
+    inv_inc: f32,
+    n: usize,
+}
+
+impl Beams {
+    /// Intersects the front faces of facing `J` with the beams they subtend, keeping the nearest
+    /// hit per beam; the beams looked at widen [k0, k1]. First every face's interval of beam
+    /// indices (branch-free over the faces, so it vectorises), then the beams of each.
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn draw_face(
+    fn draw<const J: usize>(
         &self,
-        f: &Face,
-        gx: f32,
-        gy: f32,
-        fan: &Fan,
+        faces: &[Face],
+        spans: &mut Vec<[i32; 3]>,
         dirs: &[[f32; 4]],
         out: &mut [f32],
         k0: &mut usize,
         k1: &mut usize,
     ) {
-        let vertical = f.kind < 2;
-        // back-face culling: the sensor must be on the face's free side
-        let rel = if vertical { gx - f.at } else { gy - f.at };
-        let facing_pos = f.kind == 0 || f.kind == 2;
-        if (facing_pos && rel <= 0.0) || (!facing_pos && rel >= 0.0) {
+        if faces.is_empty() {
             return;
         }
-        let (ax, ay, bx, by) = if vertical {
-            (f.at - gx, f.lo - gy, f.at - gx, f.hi - gy)
+        let vertical = J < 2;
+        let (g_at, g_along) = if vertical {
+            (self.gx, self.gy)
         } else {
-            (f.lo - gx, f.at - gy, f.hi - gx, f.at - gy)
+            (self.gy, self.gx)
         };
-        let a0 = fast_atan2(ay, ax);
-        let a1 = fast_atan2(by, bx);
-        let mut diff = a1 - a0;
-        if diff > std::f32::consts::PI {
-            diff -= std::f32::consts::TAU;
-        } else if diff < -std::f32::consts::PI {
-            diff += std::f32::consts::TAU;
+        spans.clear();
+        spans.resize(faces.len(), [0; 3]);
+        let turn = TAU * self.inv_inc;
+        let last = self.n as i32 - 1;
+        for (f, sp) in faces.iter().zip(spans.iter_mut()) {
+            let (p_at, p_lo, p_hi) = (f.at - g_at, f.lo - g_along, f.hi - g_along);
+            let (a_lo, a_hi) = if vertical {
+                (atan2_approx(p_lo, p_at), atan2_approx(p_hi, p_at))
+            } else {
+                (atan2_approx(p_at, p_lo), atan2_approx(p_at, p_hi))
+            };
+            // counter-clockwise, the face runs from its lo end to its hi end when it is to the
+            // right of the sensor (J = 1) or below it (J = 2), from hi to lo otherwise
+            let (first, mut width) = if J == 1 || J == 2 {
+                (a_lo, a_hi - a_lo)
+            } else {
+                (a_hi, a_lo - a_hi)
+            };
+            width += if width < 0.0 { TAU } else { 0.0 };
+            let mut rel = first - MARGIN - self.start;
+            rel += if rel < 0.0 { TAU } else { 0.0 };
+            rel += if rel < 0.0 { TAU } else { 0.0 };
+            // beams ⌈u0⌉ ..= ⌊u1⌋, and 0 ..= ⌊u1 − turn⌋ if the interval crosses 2π back into
+            // the fan (u0 ≥ 0, so truncation is floor; ceil by hand: no SSE4.1 rounding)
+            // (bounded, so the conversions below cannot overflow however fine the fan)
+            let u0 = (rel * self.inv_inc).min(1e9);
+            let u1 = ((rel + width + 2.0 * MARGIN) * self.inv_inc).min(1e9);
+            let r0 = u0 as i32 + ((u0 as i32 as f32) < u0) as i32;
+            let wrapped = if u1 >= turn { (u1 - turn) as i32 } else { -1 };
+            *sp = [r0, (u1 as i32).min(last), wrapped.min(last)];
         }
-        let (lo, width) = if diff >= 0.0 { (a0, diff) } else { (a1, -diff) };
-        let (p_at, p_lo, p_hi) = if vertical { (ax, ay, by) } else { (ay, ax, bx) };
-        // the perpendicular component and its reciprocal, the parallel one
         let (ia, ib) = if vertical { (2, 1) } else { (3, 0) };
-        fan.for_each_in(lo - 1e-4, width + 2e-4, |k| {
-            let d = &dirs[k];
-            let t = p_at * d[ia];
-            if !(t >= 0.0 && t < out[k]) {
-                return;
+        for (f, &[r0, r1, wrapped]) in faces.iter().zip(spans.iter()) {
+            let (p_at, p_lo, p_hi) = (f.at - g_at, f.lo - g_along, f.hi - g_along);
+            for (r0, r1) in [(r0, r1), (0, wrapped)] {
+                if r0 > r1 {
+                    continue;
+                }
+                let (r0, r1) = (r0 as usize, r1 as usize);
+                // branch-free: whether a beam hits the face nearer than before is unpredictable
+                for (d, o) in dirs[r0..=r1].iter().zip(&mut out[r0..=r1]) {
+                    let t = p_at * d[ia];
+                    let s = t * d[ib];
+                    let hit = t >= 0.0 && t < *o && s >= p_lo && s <= p_hi;
+                    *o = if hit { t } else { *o };
+                }
+                *k0 = (*k0).min(r0);
+                *k1 = (*k1).max(r1);
             }
-            let s = t * d[ib];
-            if s >= p_lo && s <= p_hi {
-                out[k] = t;
-                *k0 = (*k0).min(k);
-                *k1 = (*k1).max(k);
-            }
-        });
+        }
     }
 }
