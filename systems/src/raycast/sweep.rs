@@ -110,35 +110,48 @@ fn any_beyond(fan: &Fan, out: &[f32], bmax: &[f32], lo: f32, width: f32, near: f
     })
 }
 
-/// Occlusion test of a square region (centre offset (cx, cy) from the sensor, half diagonal
-/// `half_diag`): false if its nearest possible point lies beyond `horizon` (the longest range
-/// any beam still has) or if every beam that can cross it already hit something nearer. The
-/// sensor's own neighbourhood is always visible.
-#[allow(clippy::too_many_arguments)]
+/// Occlusion test of a tile (centre offset (cx, cy) from the sensor, half side `h`): false if
+/// its nearest point lies beyond `horizon` (the longest range any beam still has) or if every
+/// beam that can cross it already hit something nearer. The beams that can cross it are those
+/// between the two corners that bound it as seen from the sensor; a tile holding the sensor is
+/// always visible.
 #[inline]
-fn visible(
-    fan: &Fan,
-    out: &[f32],
-    bmax: &[f32],
-    cx: f32,
-    cy: f32,
-    half_diag: f32,
-    horizon: f32,
-) -> bool {
-    let dist = (cx * cx + cy * cy).sqrt();
-    let near = dist - half_diag;
+fn visible(fan: &Fan, out: &[f32], bmax: &[f32], cx: f32, cy: f32, h: f32, horizon: f32) -> bool {
+    let (qx, qy) = (cx.abs() - h, cy.abs() - h);
+    if qx <= 0.0 && qy <= 0.0 {
+        return true;
+    }
+    let near = (qx.max(0.0).powi(2) + qy.max(0.0).powi(2)).sqrt();
     if near > horizon {
         return false;
     }
-    if dist <= half_diag * 1.05 {
-        return true;
-    }
-    // the region lies within the circle of radius half_diag, which subtends ±asin(x), x < 1/1.05;
-    // asin(x) ≤ tan(asin(x)) = x / √(1 − x²): a slightly wide, never narrow, interval
-    let x = half_diag / dist;
-    let half = x / (1.0 - x * x).sqrt() + MARGIN;
-    let lo = atan2_approx(cy, cx) - half;
-    any_beyond(fan, out, bmax, lo, 2.0 * half, near)
+    let (x0, x1, y0, y1) = (cx - h, cx + h, cy - h, cy + h);
+    // the corner the arc starts from (counter-clockwise) and the one it ends at
+    let ((sx, sy), (ex, ey)) = if x0 > 0.0 {
+        if y0 >= 0.0 {
+            ((x1, y0), (x0, y1))
+        } else if y1 <= 0.0 {
+            ((x0, y0), (x1, y1))
+        } else {
+            ((x0, y0), (x0, y1))
+        }
+    } else if x1 < 0.0 {
+        if y0 >= 0.0 {
+            ((x1, y1), (x0, y0))
+        } else if y1 <= 0.0 {
+            ((x0, y1), (x1, y0))
+        } else {
+            ((x1, y1), (x1, y0))
+        }
+    } else if y0 > 0.0 {
+        ((x1, y0), (x0, y0))
+    } else {
+        ((x0, y1), (x1, y1))
+    };
+    let first = atan2_approx(sy, sx);
+    let mut width = atan2_approx(ey, ex) - first;
+    width += if width < 0.0 { TAU } else { 0.0 };
+    any_beyond(fan, out, bmax, first - MARGIN, width + 2.0 * MARGIN, near)
 }
 
 /// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`
@@ -350,7 +363,7 @@ impl Faces {
             if half_plane && cx * mx + cy * my < -half_diag {
                 continue;
             }
-            if !visible(&fan, out, bmax, cx, cy, half_diag, horizon) {
+            if !visible(&fan, out, bmax, cx, cy, tsize / 2.0, horizon) {
                 continue;
             }
             let (mut k0, mut k1) = (usize::MAX, 0);
