@@ -1,5 +1,6 @@
 //! Reactive avoidance (`navigation::avoid`), what every wandering robot of `sim bench swarm` runs
-//! each tick: reducing a 180-beam scan to sector points, and choosing a heading when the way
+//! each tick: reducing a scan to sector points (Stage's 180-beam ranger over 180° and a SICK
+//! LMS100's 1081 beams over 270°), and choosing a heading when the way
 //! ahead is blocked (a robot 1 m from the end of a 2 m wide dead end, so most candidate headings
 //! are tested before the way back is found). The ranges carry noise and a few lost beams.
 
@@ -23,12 +24,12 @@ fn dead_end_range(a: f64) -> f32 {
     if r > 8.0 { f32::INFINITY } else { r as f32 }
 }
 
-fn scan() -> LaserScan {
-    let n = 180;
-    let inc = PI / (n - 1) as f64;
+/// `n` beams over `fov` radians, centred ahead.
+fn noisy_scan(n: usize, fov: f64) -> LaserScan {
+    let inc = fov / (n - 1) as f64;
     LaserScan {
         stamp: 0.0,
-        angle_min: (-PI / 2.0) as f32,
+        angle_min: (-fov / 2.0) as f32,
         angle_increment: inc as f32,
         range_min: 0.1,
         range_max: 8.0,
@@ -40,7 +41,7 @@ fn scan() -> LaserScan {
                 if h.is_multiple_of(13) {
                     f32::INFINITY
                 } else {
-                    dead_end_range(-PI / 2.0 + k as f64 * inc) + jitter
+                    dead_end_range(-fov / 2.0 + k as f64 * inc) + jitter
                 }
             })
             .collect(),
@@ -48,7 +49,7 @@ fn scan() -> LaserScan {
 }
 
 fn bench_avoid(c: &mut Criterion) {
-    let scan = scan();
+    let scan = noisy_scan(180, PI);
     let mut g = c.benchmark_group("avoid_180_beams");
     g.bench_function("from_scan", |b| {
         b.iter(|| SectorRanges::from_scan(black_box(&scan), &Pose2::IDENTITY))
@@ -61,6 +62,13 @@ fn bench_avoid(c: &mut Criterion) {
     let sectors = SectorRanges::from_scan(&scan, &Pose2::IDENTITY);
     g.bench_function("choose_heading_dead_end", |b| {
         b.iter(|| sectors.choose_heading(black_box(0.0), 0.3, 1.8, PI * 0.8))
+    });
+    g.finish();
+    let sick = noisy_scan(1081, 1.5 * PI);
+    let mut g = c.benchmark_group("avoid_1081_beams");
+    let mut reused = SectorRanges::from_scan(&sick, &Pose2::IDENTITY);
+    g.bench_function("update", |b| {
+        b.iter(|| reused.update(black_box(&sick), &Pose2::IDENTITY))
     });
     g.finish();
 }
