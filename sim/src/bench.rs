@@ -142,6 +142,7 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     );
     if !o.json {
         println!("swarm benchmark on {map}, lasers at 10 Hz, dt 0.05 s");
+        println!("machine: {}", crate::machine::describe());
         println!(
             "{:>7} {:>6} {:>9} {:>10} {:>12} {:>14}",
             "robots", "beams", "sim s", "wall s", "× real time", "rays/s"
@@ -184,7 +185,7 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
                 map: map.clone(),
             };
             if o.json {
-                println!("{}", serde_json::to_string(&r)?);
+                println!("{}", crate::machine::json_line(&r)?);
             } else {
                 println!(
                     "{:>7} {:>6} {:>9.1} {:>10.2} {:>12.1} {:>14.3e}",

@@ -116,7 +116,7 @@ pub fn run_batch_bench(o: &BenchBatchArgs) -> anyhow::Result<BatchBenchRow> {
         identical,
     };
     if o.json {
-        println!("{}", serde_json::to_string(&row)?);
+        println!("{}", crate::machine::json_line(&row)?);
     } else {
         println!(
             "{} runs of {} ({} s simulated each), median of {}:\n\

@@ -207,7 +207,7 @@ pub fn run_mcl_bench(o: &LocBenchOptions) -> anyhow::Result<()> {
             threads: 1,
         };
         if o.json {
-            println!("{}", serde_json::to_string(&row)?);
+            println!("{}", crate::machine::json_line(&row)?);
         } else {
             println!(
                 "{:>10} {:>6} {:>12.3} {:>10.3} {:>10.3} {:>10.3} {:>14.3e}",
@@ -288,7 +288,7 @@ pub fn run_markov_grid_bench(o: &LocBenchOptions) -> anyhow::Result<()> {
             threads: 1,
         };
         if o.json {
-            println!("{}", serde_json::to_string(&row)?);
+            println!("{}", crate::machine::json_line(&row)?);
         } else {
             println!(
                 "{:>10} {:>10} {:>6} {:>12.3} {:>10.3} {:>10.3}",

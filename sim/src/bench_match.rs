@@ -97,7 +97,7 @@ pub fn run_de_match_bench(o: &DeMatchBenchOptions) -> anyhow::Result<()> {
             threads: 1,
         };
         if o.json {
-            println!("{}", serde_json::to_string(&row)?);
+            println!("{}", crate::machine::json_line(&row)?);
         } else {
             println!(
                 "{:<50} {:>10.3} {:>10.3} {:>10.3} {:>10} {:>8.1}",

@@ -143,7 +143,7 @@ pub fn run_record_bench(o: &RecordBenchOptions) -> anyhow::Result<Vec<RecordBenc
                 mcap_messages,
             };
             if o.json {
-                println!("{}", serde_json::to_string(&row)?);
+                println!("{}", crate::machine::json_line(&row)?);
             } else {
                 println!(
                     "{:<20} {:>5} {:>7.1} {:>10.2} {:>9.1}% {:>10.2} {:>10.2} {:>10}",

@@ -102,7 +102,7 @@ pub fn run_slam_bench(o: &SlamBenchOptions) -> anyhow::Result<Vec<SlamBenchRow>>
             },
         };
         if o.json {
-            println!("{}", serde_json::to_string(&row)?);
+            println!("{}", crate::machine::json_line(&row)?);
         }
         rows.push(row);
     }

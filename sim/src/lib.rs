@@ -14,6 +14,7 @@ pub mod carmen;
 pub mod carmen_out;
 pub mod experiment;
 pub mod interrupt;
+pub mod machine;
 pub mod map_out;
 pub mod match_cmd;
 pub mod mcap_out;

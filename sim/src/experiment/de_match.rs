@@ -339,7 +339,7 @@ pub fn run_de_match_experiment(o: &DeMatchOptions) -> anyhow::Result<()> {
     let rows = de_match_rows(o)?;
     if o.json {
         for r in &rows {
-            println!("{}", serde_json::to_string(r)?);
+            println!("{}", crate::machine::json_line(r)?);
         }
     } else {
         print!("{}", table(&rows));

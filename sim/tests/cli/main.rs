@@ -243,6 +243,9 @@ fn bench_rows(args: &[&str], fields: &[&str]) -> Vec<serde_json::Value> {
         .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{e}: {l}")))
         .collect();
     for row in &rows {
+        // the processor, so figures from different machines are not compared unawares
+        let machine = row["machine"].as_str().unwrap_or_default();
+        assert!(machine.contains("CPU"), "no machine in {row}");
         for f in fields {
             let x = row[f].as_f64().unwrap_or_else(|| panic!("no {f} in {row}"));
             assert!(x.is_finite() && x > 0.0, "{f} = {x} in {row}");
