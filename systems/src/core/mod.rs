@@ -3,6 +3,7 @@
 //! tree is, for its assets).
 
 pub mod clock;
+pub mod cpu;
 pub mod ids;
 pub mod moments;
 pub mod normal;

@@ -45,17 +45,21 @@ pub fn range_costs(
     out.par_chunks_mut(CHUNK)
         .zip(poses.par_chunks(CHUNK))
         .for_each(|(oc, pc)| {
-            let mut batch = Vec::with_capacity(m);
-            let mut expected = vec![0.0f32; m];
-            for (o, p) in oc.iter_mut().zip(pc) {
-                let sensor = Pose2::new(p[0], p[1], p[2]).compose(&beams.mount);
-                let origin = [sensor.x as f32, sensor.y as f32];
-                let th = p[2] as f32;
-                batch.clear();
-                batch.extend(beams.angles.iter().map(|&a| (origin, th + a)));
-                map.rays.cast_many(&batch, rmax, &mut expected);
+            // the chunk's beams in one stream, so the caster keeps its lanes full
+            let batch: Vec<([f32; 2], f32)> = pc
+                .iter()
+                .flat_map(|p| {
+                    let sensor = Pose2::new(p[0], p[1], p[2]).compose(&beams.mount);
+                    let origin = [sensor.x as f32, sensor.y as f32];
+                    let th = p[2] as f32;
+                    beams.angles.iter().map(move |&a| (origin, th + a))
+                })
+                .collect();
+            let mut all = vec![0.0f32; batch.len()];
+            map.rays.cast_many(&batch, rmax, &mut all);
+            for (o, expected) in oc.iter_mut().zip(all.chunks_exact(m)) {
                 let mut sum = 0.0f64;
-                for (z, zs) in beams.ranges.iter().zip(&expected) {
+                for (z, zs) in beams.ranges.iter().zip(expected) {
                     let d = (z.min(rmax) - zs.min(rmax)) as f64;
                     sum += match metric {
                         RangeMetric::L1 => d.abs(),

@@ -1,9 +1,12 @@
 //! Many independent rays at once ("ray streams"): a single ray on the distance field is a chain of
 //! dependent memory loads — each leap needs the byte at the cell the previous leap landed in — so
-//! one ray leaves the core idle most of the time. Here `LANES` rays advance in turn, one leap or
+//! one ray leaves the core idle most of the time. Here several rays advance in turn, one leap or
 //! cell step each per round, so the loads of different rays overlap; a lane whose ray ends takes
-//! the next one. Every step is the one [`RayMap::cast`] takes (crossing times from the cell
+//! the next one. Every step is the one [`Lane::advance`] takes (crossing times from the cell
 //! indices, never accumulated), so results agree with the cell walk of [`super::cast_dda`].
+//!
+//! Two kernels with the same answers: with AVX2 (detected at run time) 32 rays in four
+//! vectors (`batch_avx2`), otherwise `LANES` rays one after another.
 //!
 //! This is what a particle filter needs (every particle's beams at once: the `calc_range_many`
 //! of range_libc, Walsh & Karaman 2018) and what scans fall back to when the sweep does not apply.
@@ -11,8 +14,41 @@
 use super::leap::{Bounds, Lane};
 use super::raymap::RayMap;
 
-/// Rays in flight. Eight is enough to hide an L2/L3 load behind the other lanes' arithmetic.
+/// Rays in flight in the scalar kernel. Eight is enough to hide an L2/L3 load behind the other
+/// lanes' arithmetic.
 const LANES: usize = 8;
+
+/// The rays of a stream in order, placed where they enter the grid; rays with nothing to walk
+/// (starting outside the grid and missing it, or undefined) are answered on the way.
+pub(super) struct Feed<'a, F> {
+    ray: F,
+    n: usize,
+    next: usize,
+    b: &'a Bounds,
+    origin: [f32; 2],
+    max_range: f32,
+}
+
+impl<F: Fn(usize) -> ([f32; 2], f32, f32)> Feed<'_, F> {
+    /// The next ray to walk, its `id` set to its index, or None when the stream is done.
+    #[inline]
+    pub fn next(&mut self, out: &mut [f32]) -> Option<Lane> {
+        while self.next < self.n {
+            let i = self.next;
+            self.next += 1;
+            let (p, dx, dy) = (self.ray)(i);
+            let (gx, gy) = (p[0] - self.origin[0], p[1] - self.origin[1]);
+            match Lane::start(gx, gy, dx, dy, self.b, self.max_range) {
+                Ok(mut l) => {
+                    l.id = i;
+                    return Some(l);
+                }
+                Err(answer) => out[i] = answer,
+            }
+        }
+        None
+    }
+}
 
 impl RayMap {
     /// Casts rays `(origin, angle)` into `out` (same length): `out[i]` is what
@@ -40,32 +76,48 @@ impl RayMap {
         out: &mut [f32],
     ) {
         let b = Bounds::new(self.width(), self.height(), self.resolution());
-        let origin = self.origin();
+        let feed = Feed {
+            ray,
+            n,
+            next: 0,
+            b: &b,
+            origin: self.origin(),
+            max_range,
+        };
+        #[cfg(target_arch = "x86_64")]
+        if self.stream_avx2() {
+            // SAFETY: AVX2 was detected; the padded field fits `i32` indices (`stream_avx2`)
+            unsafe {
+                super::batch_avx2::cast_stream_avx2(
+                    self.dist_padded(),
+                    self.tiles_per_row(),
+                    &b,
+                    max_range,
+                    feed,
+                    out,
+                )
+            };
+            return;
+        }
+        self.cast_stream_scalar(&b, max_range, feed, out);
+    }
+
+    /// The scalar stream kernel.
+    pub(super) fn cast_stream_scalar(
+        &self,
+        b: &Bounds,
+        max_range: f32,
+        mut feed: Feed<impl Fn(usize) -> ([f32; 2], f32, f32)>,
+        out: &mut [f32],
+    ) {
         let dist = self.dist();
         let mut lanes = [Lane::default(); LANES];
-        let mut next = 0usize;
-        // starts ray `next` (or later ones) in `lane`; rays that begin outside the grid or in an
-        // occupied cell are answered at once. Returns false when no rays are left.
-        let start = |lane: &mut Lane, next: &mut usize, out: &mut [f32]| -> bool {
-            while *next < n {
-                let i = *next;
-                *next += 1;
-                let (p, dx, dy) = ray(i);
-                let (gx, gy) = (p[0] - origin[0], p[1] - origin[1]);
-                match Lane::start(gx, gy, dx, dy, &b, max_range) {
-                    Ok(l) => *lane = l,
-                    Err(answer) => {
-                        out[i] = answer;
-                        continue;
-                    }
-                }
-                lane.id = i;
-                return true;
-            }
-            false
-        };
         let mut active = 0;
-        while active < LANES && start(&mut lanes[active], &mut next, out) {
+        while active < LANES {
+            match feed.next(out) {
+                Some(l) => lanes[active] = l,
+                None => break,
+            }
             active += 1;
         }
         while active > 0 {
@@ -76,16 +128,21 @@ impl RayMap {
                 let done = if k == 0 {
                     out[l.id] = l.t;
                     true
-                } else if !l.advance(k, &b, max_range) {
+                } else if !l.advance(k, b, max_range) {
                     out[l.id] = f32::INFINITY;
                     true
                 } else {
                     false
                 };
-                if done && !start(&mut lanes[j], &mut next, out) {
-                    active -= 1;
-                    lanes[j] = lanes[active];
-                    continue;
+                if done {
+                    match feed.next(out) {
+                        Some(l) => lanes[j] = l,
+                        None => {
+                            active -= 1;
+                            lanes[j] = lanes[active];
+                            continue;
+                        }
+                    }
                 }
                 j += 1;
             }

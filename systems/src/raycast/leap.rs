@@ -25,20 +25,20 @@ use super::dda::{enter_grid, step_sign};
 /// A ray in grid-relative metres, and the cell it is in.
 #[derive(Clone, Copy, Default)]
 pub(super) struct Lane {
-    gx: f32,
-    gy: f32,
-    dx: f32,
-    dy: f32,
+    pub gx: f32,
+    pub gy: f32,
+    pub dx: f32,
+    pub dy: f32,
     /// 1/dx, 1/dy (finite: only used when the step sign is non-zero).
-    idx: f32,
-    idy: f32,
+    pub idx: f32,
+    pub idy: f32,
     /// Cell steps and the offsets (0 or 1) of the next boundary.
-    sx: i32,
-    sy: i32,
-    bx: i32,
-    by: i32,
+    pub sx: i32,
+    pub sy: i32,
+    pub bx: i32,
+    pub by: i32,
     /// Length of one cell of L∞ travel along the ray.
-    leap: f32,
+    pub leap: f32,
     pub cx: i32,
     pub cy: i32,
     /// Parameter at which the ray entered the current cell (or landed in it after a leap).

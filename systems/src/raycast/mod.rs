@@ -7,8 +7,9 @@
 //! - [`RayMap`]: the static map as a one-byte Chebyshev distance field (rays leap across open
 //!   space and walk cell by cell only next to obstacles) plus the boundary faces of occupied
 //!   cells per tile. `cast` is one ray, `cast_many` many independent rays advanced in turn so
-//!   their memory loads overlap, and `cast_scan` a whole scan by an angular sweep over the faces
-//!   (front to back, skipping hidden tiles). Results agree with [`cast_dda`] (single rays to
+//!   their memory loads overlap (with AVX2, 32 rays in four vectors: `batch_avx2`), and
+//!   `cast_scan` a whole scan by an angular sweep over the faces (front to back, skipping
+//!   hidden tiles). Results agree with [`cast_dda`] (single rays to
 //!   millimetres where they graze a wall, see `leap`); edits (doors) refresh the field and the
 //!   faces locally.
 //! - [`overlay_circles`], [`overlay_segments`]: moving obstacles (other robots) drawn into an
@@ -18,6 +19,8 @@
 //! starting in an occupied cell returns 0; no hit within `max_range` returns `f32::INFINITY`.
 
 mod batch;
+#[cfg(target_arch = "x86_64")]
+mod batch_avx2;
 mod dda;
 mod fan;
 mod leap;

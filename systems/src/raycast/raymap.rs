@@ -17,6 +17,8 @@ use super::sweep::{Faces, TILE as FACE_TILE};
 const CAP: u8 = 120;
 const TILE_SHIFT: usize = 3;
 const TILE: usize = 1 << TILE_SHIFT;
+/// Bytes after the field's last cell, so a 4-byte gather at any cell stays inside it.
+const PAD: usize = 3;
 
 pub struct RayMap {
     w: usize,
@@ -25,7 +27,10 @@ pub struct RayMap {
     origin: [f32; 2],
     /// Tiles per row.
     tw: usize,
+    /// The field in tiled order, then [`PAD`] bytes.
     dist: Vec<u8>,
+    /// Streams of rays use the AVX2 kernel (detected, and the field fits `i32` indices).
+    avx2: bool,
     /// Boundary faces per tile, for whole scans.
     faces: Faces,
 }
@@ -58,7 +63,8 @@ impl RayMap {
             res: resolution,
             origin,
             tw,
-            dist: vec![CAP; tw * th * TILE * TILE],
+            dist: vec![CAP; tw * th * TILE * TILE + PAD],
+            avx2: crate::core::cpu::has_avx2() && tw * th * TILE * TILE + PAD <= i32::MAX as usize,
             faces: Faces::new(0, 0, resolution, &|_, _| false),
         };
         for r in 0..height {
@@ -92,7 +98,28 @@ impl RayMap {
 
     /// The distance field in tiled order (see [`RayMap::idx`]).
     pub(super) fn dist(&self) -> &[u8] {
+        &self.dist[..self.dist.len() - PAD]
+    }
+
+    /// The field and its padding, for gathers.
+    pub(super) fn dist_padded(&self) -> &[u8] {
         &self.dist
+    }
+
+    pub(super) fn tiles_per_row(&self) -> usize {
+        self.tw
+    }
+
+    /// Whether streams of rays use the AVX2 kernel.
+    pub(super) fn stream_avx2(&self) -> bool {
+        self.avx2
+    }
+
+    /// The same map with streams on the scalar kernel (to compare the two).
+    #[cfg(test)]
+    pub(super) fn without_avx2(mut self) -> Self {
+        self.avx2 = false;
+        self
     }
 
     pub fn width(&self) -> usize {

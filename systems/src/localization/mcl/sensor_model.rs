@@ -186,16 +186,18 @@ pub fn weigh_beam_model(
     let rand = p.z_rand / range_max as f64;
     w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, wc)| {
         let base = c * CHUNK;
-        let mut batch = Vec::with_capacity(m);
-        let mut expected = vec![0.0f32; m];
-        for (j, wi) in wc.iter_mut().enumerate() {
-            let i = base + j;
-            let sensor = Pose2::new(xs[i], ys[i], ths[i]).compose(&beams.mount);
-            let origin = [sensor.x as f32, sensor.y as f32];
-            let th = ths[i] as f32;
-            batch.clear();
-            batch.extend(beams.angles.iter().map(|&a| (origin, th + a)));
-            rays.cast_many(&batch, range_max, &mut expected);
+        // the chunk's beams in one stream, so the caster keeps its lanes full
+        let batch: Vec<([f32; 2], f32)> = (base..base + wc.len())
+            .flat_map(|i| {
+                let sensor = Pose2::new(xs[i], ys[i], ths[i]).compose(&beams.mount);
+                let origin = [sensor.x as f32, sensor.y as f32];
+                let th = ths[i] as f32;
+                beams.angles.iter().map(move |&a| (origin, th + a))
+            })
+            .collect();
+        let mut all = vec![0.0f32; batch.len()];
+        rays.cast_many(&batch, range_max, &mut all);
+        for (wi, expected) in wc.iter_mut().zip(all.chunks_exact(m)) {
             let mut total = 1.0f64;
             for (k, &zs) in expected.iter().enumerate() {
                 let z = beams.ranges[k] as f64;

@@ -196,18 +196,8 @@ impl<'a> FrameView<'a> {
                 }),
                 joint: std::array::from_fn(|k| palette.classes[k].joints),
             },
-            avx2: Self::has_avx2() && raster.cells.len() < i32::MAX as usize,
+            avx2: crate::core::cpu::has_avx2() && raster.cells.len() < i32::MAX as usize,
         }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    fn has_avx2() -> bool {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-
-    #[cfg(not(target_arch = "x86_64"))]
-    fn has_avx2() -> bool {
-        false
     }
 
     /// The same view rendering whole rows without AVX2 (tests: both give the same bytes).
