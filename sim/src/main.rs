@@ -311,6 +311,7 @@ enum ExperimentCommand {
 }
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
@@ -326,6 +327,16 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         }
+    }
+}
+
+/// Ends quietly when whoever reads standard output goes away (`sim bench swarm --json | head -2`),
+/// as Unix tools do: Rust ignores SIGPIPE, so the next write to the closed pipe panicked.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: the default disposition of a signal, set before any other thread exists
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

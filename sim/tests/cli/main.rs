@@ -229,6 +229,30 @@ fn scenarios_lists_the_bundled_ones() {
 }
 
 /// Parses every line of a `--json` bench output and checks the fields each row must have.
+/// Output into a pipe nobody reads (`sim scenarios | head -0`): the process ends by SIGPIPE, as
+/// Unix tools do, not with a panic about a failed print.
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_sim"))
+        .arg("scenarios")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(
+        out.status.signal(),
+        Some(libc::SIGPIPE),
+        "{:?} {stderr}",
+        out.status
+    );
+}
+
 fn bench_rows(args: &[&str], fields: &[&str]) -> Vec<serde_json::Value> {
     let dir = tempfile::tempdir().unwrap();
     let out = sim(args, dir.path());
