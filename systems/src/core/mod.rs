@@ -12,6 +12,7 @@ pub mod pose;
 pub mod rng;
 pub mod schedule;
 pub mod source;
+pub mod spatial_order;
 
 pub use clock::SimClock;
 pub use ids::{RobotId, RobotIndex};
