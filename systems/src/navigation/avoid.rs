@@ -259,6 +259,77 @@ mod tests {
         assert!(h.abs() > 2.0 && (f - most).abs() < 1e-4, "{h} {f} {most}");
     }
 
+    /// The reduction beam by beam into the sectors' slots, as the definition reads.
+    fn reduce_by_definition(scan: &LaserScan, mount: &Pose2) -> Vec<(f32, f32)> {
+        let mut best = [(f32::INFINITY, 0f32, 0f32); SECTORS];
+        for (k, &r) in scan.ranges.iter().enumerate() {
+            let r = if r == f32::NEG_INFINITY {
+                scan.range_min
+            } else {
+                r
+            };
+            if !r.is_finite() {
+                continue;
+            }
+            let a = scan.angle_min as f64 + mount.theta + k as f64 * scan.angle_increment as f64;
+            let (s, c) = a.sin_cos();
+            let (px, py) = (mount.x as f32 + c as f32 * r, mount.y as f32 + s as f32 * r);
+            let sector = ((a.rem_euclid(2.0 * PI) / SECTOR_WIDTH) as usize).min(SECTORS - 1);
+            let d2 = px * px + py * py;
+            if d2 < best[sector].0 {
+                best[sector] = (d2, px, py);
+            }
+        }
+        best.iter()
+            .filter(|b| b.0.is_finite())
+            .map(|b| (b.1, b.2))
+            .collect()
+    }
+
+    #[test]
+    fn runs_of_a_sector_reduce_as_beam_by_beam() {
+        // fans that cross 2π (so one sector's beams come in two runs), lost beams (+Inf, NaN),
+        // readings below range_min (-Inf), equal ranges (the first beam wins a tie)
+        for (n, fov, first, mount) in [
+            (180, PI, -PI / 2.0, Pose2::IDENTITY),
+            (
+                1081,
+                1.5 * PI,
+                100f64.to_radians(),
+                Pose2::new(0.2, -0.1, 0.3),
+            ),
+            (720, 2.0 * PI - 0.01, -PI, Pose2::new(-0.3, 0.0, PI)),
+            // from 1° round to 0.5°: sector 0's beams at both ends
+            (
+                720,
+                359.5f64.to_radians(),
+                1f64.to_radians(),
+                Pose2::IDENTITY,
+            ),
+            (7, 0.3, 6.2, Pose2::IDENTITY),
+        ] {
+            let ranges: Vec<f32> = (0..n)
+                .map(|k| match (k * 7919) % 23 {
+                    0 => f32::INFINITY,
+                    1 => f32::NAN,
+                    2 => f32::NEG_INFINITY,
+                    3 | 4 => 2.0,
+                    h => 0.5 + h as f32 * 0.37 + (k % 5) as f32 * 0.01,
+                })
+                .collect();
+            let scan = LaserScan {
+                stamp: 0.0,
+                angle_min: first as f32,
+                angle_increment: (fov / (n - 1).max(1) as f64) as f32,
+                range_min: 0.1,
+                range_max: 20.0,
+                ranges,
+            };
+            let got: Vec<_> = SectorRanges::from_scan(&scan, &mount).points().collect();
+            assert_eq!(got, reduce_by_definition(&scan, &mount), "{n} beams");
+        }
+    }
+
     #[test]
     fn reused_storage_gives_the_same_reduction() {
         let first = wall_scan(2.0);
