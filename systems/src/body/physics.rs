@@ -399,3 +399,29 @@ impl SimPlugin for PhysicsPlugin {
 pub fn collisions_of(physics: &Physics, index: &RobotIndex) -> Collisions {
     physics.collisions(index.0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Widening the skin leaves every length the solver derives from the length unit as it was,
+    /// to the bit (so contacts, tolerances and velocity caps do not change with it).
+    #[test]
+    fn a_wider_skin_leaves_the_solver_lengths_exact() {
+        let default = IntegrationParameters::default();
+        let mut widened = default;
+        widen_broad_phase_skin(&mut widened);
+        assert_eq!(widened.length_unit, default.length_unit * SKIN_SCALE);
+        let lengths = |p: &IntegrationParameters| {
+            [
+                p.allowed_linear_error(),
+                p.max_corrective_velocity(),
+                p.prediction_distance(),
+                p.max_linear_velocity(),
+                p.contact_recycle_distance(),
+            ]
+            .map(f32::to_bits)
+        };
+        assert_eq!(lengths(&widened), lengths(&default));
+    }
+}
