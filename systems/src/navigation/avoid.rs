@@ -25,15 +25,21 @@ pub struct SectorRanges {
     len: usize,
 }
 
-/// A scan's beams in the robot's base frame: each beam's direction and sector. It depends only
-/// on the laser's angles and mount, so it is built once and reused for every scan of the same
-/// geometry.
+/// A scan's beams in the robot's base frame: each beam's direction, and the runs of beams that
+/// fall in the same sector. It depends only on the laser's angles and mount, so it is built once
+/// and reused for every scan of the same geometry.
 #[derive(Default)]
 struct BeamSectors {
     /// angle_min, angle_increment, beam count, mount (x, y, θ) as bits: what the table is for.
     key: (u32, u32, usize, [u64; 3]),
-    /// cos and sin of each beam's angle in the base frame, and its sector.
-    beams: Vec<(f32, f32, u32)>,
+    /// cos and sin of each beam's angle in the base frame, as columns.
+    cos: Vec<f32>,
+    sin: Vec<f32>,
+    /// (sector, first beam, end beam) of each run of consecutive beams in one sector, in beam
+    /// order (a fan crossing 2π visits a sector in two runs).
+    runs: Vec<(u32, u32, u32)>,
+    /// Scratch: each beam's squared distance from the robot's centre in the current scan.
+    d2: Vec<f32>,
 }
 
 impl BeamSectors {
@@ -50,14 +56,21 @@ impl BeamSectors {
         self.key = Self::key(scan, mount);
         let a0 = scan.angle_min as f64 + mount.theta;
         let inc = scan.angle_increment as f64;
-        self.beams = (0..scan.ranges.len())
-            .map(|k| {
-                let a = a0 + k as f64 * inc;
-                let (s, c) = a.sin_cos();
-                let sector = ((a.rem_euclid(2.0 * PI) / SECTOR_WIDTH) as usize).min(SECTORS - 1);
-                (c as f32, s as f32, sector as u32)
-            })
-            .collect();
+        let n = scan.ranges.len();
+        (self.cos, self.sin) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        self.runs.clear();
+        for k in 0..n {
+            let a = a0 + k as f64 * inc;
+            let (s, c) = a.sin_cos();
+            let sector = ((a.rem_euclid(2.0 * PI) / SECTOR_WIDTH) as usize).min(SECTORS - 1);
+            self.cos.push(c as f32);
+            self.sin.push(s as f32);
+            match self.runs.last_mut() {
+                Some((last, _, end)) if *last == sector as u32 => *end = k as u32 + 1,
+                _ => self.runs.push((sector as u32, k as u32, k as u32 + 1)),
+            }
+        }
+        self.d2 = vec![0.0; n];
     }
 }
 
@@ -86,37 +99,74 @@ impl SectorRanges {
         });
     }
 
-    fn reduce(&mut self, scan: &LaserScan, mount: &Pose2, table: &BeamSectors) {
-        let mut best = [f32::INFINITY; SECTORS];
-        let mut nearest = [(0f32, 0f32); SECTORS];
+    fn reduce(&mut self, scan: &LaserScan, mount: &Pose2, table: &mut BeamSectors) {
+        if scan.ranges.is_empty() {
+            self.xs.clear();
+            self.ys.clear();
+            self.len = 0;
+            return;
+        }
         let (mx, my) = (mount.x as f32, mount.y as f32);
-        for (&r, &(c, s, sector)) in scan.ranges.iter().zip(&table.beams) {
-            // a reading below range_min (-Inf) means something very close: treat it as range_min
-            let r = if r == f32::NEG_INFINITY {
+        // a reading below range_min (-Inf) means something very close: taken as range_min
+        let reading = |r: f32| {
+            if r == f32::NEG_INFINITY {
                 scan.range_min
             } else {
                 r
-            };
-            if !r.is_finite() {
-                continue;
             }
+        };
+        // every beam's squared distance from the centre, as one vectorized pass; a lost beam
+        // (+Inf, NaN) gives +Inf or NaN, which never compares below anything
+        let BeamSectors {
+            cos, sin, runs, d2, ..
+        } = table;
+        for (((d, &r), &c), &s) in d2.iter_mut().zip(&scan.ranges).zip(&*cos).zip(&*sin) {
+            let r = reading(r);
             let (px, py) = (mx + c * r, my + s * r);
-            let d2 = px * px + py * py;
-            let i = sector as usize % SECTORS;
-            if d2 < best[i] {
-                best[i] = d2;
-                nearest[i] = (px, py);
-            }
+            *d = px * px + py * py;
         }
+        // the nearest beam of each run without a branch on the readings (whether a beam is
+        // lost or nearer than the one before is a coin toss in a real scan); one slot more than
+        // there are sectors, for a run that is not nearer than its sector's best (a sector
+        // seen in two runs, when the fan crosses 2π, keeps the nearer, on a tie the earlier)
+        const DISCARD: usize = SECTORS;
+        let mut best = [f32::INFINITY; SECTORS + 1];
+        let mut nearest = [(0f32, 0f32); SECTORS + 1];
+        for &(sector, start, end) in runs.iter() {
+            let (start, end) = (start as usize, end as usize);
+            let (mut bd, mut bk) = (f32::INFINITY, start);
+            for (k, &d) in d2[start..end].iter().enumerate() {
+                let k = start + k;
+                let nearer = d < bd;
+                bd = if nearer { d } else { bd };
+                bk = if nearer { k } else { bk };
+            }
+            let i = sector as usize;
+            let slot = if bd < best[i] { i } else { DISCARD };
+            let r = reading(scan.ranges[bk]);
+            best[slot] = bd;
+            nearest[slot] = (mx + cos[bk] * r, my + sin[bk] * r);
+        }
+        // the list of the sectors that saw something, compacted without a branch either:
+        // every sector's point is written at the end of the list, which only grows past a
+        // sector that saw something
+        let padded = SECTORS + LANES;
         self.xs.clear();
         self.ys.clear();
-        for i in (0..SECTORS).filter(|&i| best[i].is_finite()) {
-            self.xs.push(nearest[i].0);
-            self.ys.push(nearest[i].1);
+        self.xs.resize(padded, f32::NAN);
+        self.ys.resize(padded, f32::NAN);
+        let mut len = 0;
+        for (&d, &(x, y)) in best[..SECTORS].iter().zip(&nearest[..SECTORS]) {
+            self.xs[len] = x;
+            self.ys[len] = y;
+            len += d.is_finite() as usize;
         }
-        self.len = self.xs.len();
-        self.xs.resize(self.len.next_multiple_of(LANES), f32::NAN);
-        self.ys.resize(self.len.next_multiple_of(LANES), f32::NAN);
+        self.len = len;
+        let end = len.next_multiple_of(LANES);
+        self.xs[len..end].fill(f32::NAN);
+        self.ys[len..end].fill(f32::NAN);
+        self.xs.truncate(end);
+        self.ys.truncate(end);
     }
 
     /// The seen points (base frame), in sector order.

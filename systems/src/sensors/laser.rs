@@ -137,6 +137,8 @@ pub struct LaserScans {
     pub scans: Vec<LaserScan>,
     /// The last scan of an earlier tick (kept by moving, not copying, at [`LaserScans::next_tick`]).
     previous: Option<LaserScan>,
+    /// Range buffers of dropped scans, for [`LaserScans::buffer`] to hand out again.
+    spare: Vec<Vec<f32>>,
 }
 
 impl LaserScans {
@@ -146,11 +148,23 @@ impl LaserScans {
     }
 
     /// Starts a tick: this tick's scans are dropped, except the last, which stays the latest.
+    /// Their range buffers are kept for the next scans.
     pub fn next_tick(&mut self) {
-        if let Some(last) = self.scans.pop() {
-            self.previous = Some(last);
+        if let Some(last) = self.scans.pop()
+            && let Some(old) = self.previous.replace(last)
+        {
+            self.spare.push(old.ranges);
         }
-        self.scans.clear();
+        self.spare.extend(self.scans.drain(..).map(|s| s.ranges));
+    }
+
+    /// A buffer of `n` zeros for a new scan's ranges: a dropped scan's when there is one (a
+    /// swarm's lasers otherwise allocated and freed one per scan, often on different threads).
+    pub fn buffer(&mut self, n: usize) -> Vec<f32> {
+        let mut b = self.spare.pop().unwrap_or_default();
+        b.clear();
+        b.resize(n, 0.0);
+        b
     }
 }
 
@@ -242,7 +256,7 @@ pub fn sample_lasers(
                 let p = [sensor.x as f32, sensor.y as f32];
                 let a0 = (sensor.theta + spec.angle_min()) as f32;
                 let inc = spec.increment as f32;
-                let mut ranges = vec![0f32; n];
+                let mut ranges = scans.buffer(n);
                 rays.cast_scan(p, a0, inc, spec.max_range as f32, &mut ranges);
                 outlines.near(
                     sensor.x,
@@ -297,6 +311,56 @@ mod tests {
         assert_eq!(s.latest().map(|l| l.stamp), Some(0.2));
         s.scans.push(scan(0.5));
         assert_eq!(s.latest().map(|l| l.stamp), Some(0.5));
+    }
+
+    /// Dropped scans' buffers come back zeroed and at the asked length, the latest scan stays
+    /// readable, and the spare buffers do not pile up.
+    #[test]
+    fn scan_buffers_are_reused_zeroed() {
+        let mut s = LaserScans::default();
+        let fire = |s: &mut LaserScans, stamp: f64, n: usize| {
+            let mut ranges = s.buffer(n);
+            assert_eq!(ranges, vec![0.0; n], "a fresh buffer is zeros");
+            ranges.iter_mut().for_each(|r| *r = 7.0);
+            let ptr = ranges.as_ptr();
+            s.scans.push(LaserScan {
+                stamp,
+                angle_min: 0.0,
+                angle_increment: 0.1,
+                range_min: 0.1,
+                range_max: 10.0,
+                ranges,
+            });
+            ptr
+        };
+        let mut seen = Vec::new();
+        for tick in 0..20 {
+            s.next_tick();
+            // two scans on even ticks, none on odd ones
+            if tick % 2 == 0 {
+                seen.push(fire(&mut s, tick as f64, 5));
+                seen.push(fire(&mut s, tick as f64 + 0.5, 3 + tick % 4));
+            }
+            let latest = s.latest().map(|l| l.stamp).unwrap_or(-1.0);
+            let want = if tick % 2 == 0 {
+                tick as f64 + 0.5
+            } else {
+                tick as f64 - 0.5
+            };
+            assert_eq!(latest, want, "tick {tick}");
+            assert!(
+                s.spare.len() <= 2,
+                "spare buffers pile up: {}",
+                s.spare.len()
+            );
+        }
+        seen.sort();
+        seen.dedup();
+        assert!(
+            seen.len() <= 3,
+            "{} distinct buffers for 20 scans",
+            seen.len()
+        );
     }
 
     #[test]
