@@ -14,15 +14,31 @@ const SECTOR_WIDTH: f64 = 2.0 * PI / SECTORS as f64;
 /// Points tested side by side (the padding of the coordinate columns).
 const LANES: usize = 8;
 
+/// Length of the coordinate columns: every sector, padded to whole lanes.
+const PADDED: usize = SECTORS.next_multiple_of(LANES);
+
 /// The nearest scan point of each 2° sector around the robot that saw something, in its base
-/// frame (a compact list: headings are tested against the points only).
-#[derive(Clone, Debug, Default)]
+/// frame (a compact list: headings are tested against the points only). The columns are kept
+/// inline, not on the heap: a behaviour reads them every tick, and its robots' components lie one
+/// after the other in memory, which the processor's prefetcher follows (separate heap
+/// allocations it cannot guess).
+#[derive(Clone, Debug)]
 pub struct SectorRanges {
     /// x and y of the points, in sector order, padded with NaN to a multiple of [`LANES`] (a NaN
     /// point never blocks a heading).
-    xs: Vec<f32>,
-    ys: Vec<f32>,
+    xs: [f32; PADDED],
+    ys: [f32; PADDED],
     len: usize,
+}
+
+impl Default for SectorRanges {
+    fn default() -> Self {
+        SectorRanges {
+            xs: [f32::NAN; PADDED],
+            ys: [f32::NAN; PADDED],
+            len: 0,
+        }
+    }
 }
 
 /// A scan's beams in the robot's base frame: each beam's direction, and the runs of beams that
@@ -101,8 +117,6 @@ impl SectorRanges {
 
     fn reduce(&mut self, scan: &LaserScan, mount: &Pose2, table: &mut BeamSectors) {
         if scan.ranges.is_empty() {
-            self.xs.clear();
-            self.ys.clear();
             self.len = 0;
             return;
         }
@@ -150,11 +164,6 @@ impl SectorRanges {
         // the list of the sectors that saw something, compacted without a branch either:
         // every sector's point is written at the end of the list, which only grows past a
         // sector that saw something
-        let padded = SECTORS + LANES;
-        self.xs.clear();
-        self.ys.clear();
-        self.xs.resize(padded, f32::NAN);
-        self.ys.resize(padded, f32::NAN);
         let mut len = 0;
         for (&d, &(x, y)) in best[..SECTORS].iter().zip(&nearest[..SECTORS]) {
             self.xs[len] = x;
@@ -165,8 +174,6 @@ impl SectorRanges {
         let end = len.next_multiple_of(LANES);
         self.xs[len..end].fill(f32::NAN);
         self.ys[len..end].fill(f32::NAN);
-        self.xs.truncate(end);
-        self.ys.truncate(end);
     }
 
     /// The seen points (base frame), in sector order.
@@ -189,7 +196,9 @@ impl SectorRanges {
         let (ux, uy) = (ux as f32, uy as f32);
         // one running minimum per lane (the minimum of a set does not depend on the order)
         let mut free = [f32::INFINITY; LANES];
-        for (xs, ys) in self.xs.chunks_exact(LANES).zip(self.ys.chunks_exact(LANES)) {
+        let end = self.len.next_multiple_of(LANES);
+        let (xs, ys) = (&self.xs[..end], &self.ys[..end]);
+        for (xs, ys) in xs.chunks_exact(LANES).zip(ys.chunks_exact(LANES)) {
             for l in 0..LANES {
                 let (x, y) = (xs[l], ys[l]);
                 let along = x * ux + y * uy;
