@@ -116,10 +116,6 @@ impl SectorRanges {
     }
 
     fn reduce(&mut self, scan: &LaserScan, mount: &Pose2, table: &mut BeamSectors) {
-        if scan.ranges.is_empty() {
-            self.len = 0;
-            return;
-        }
         let (mx, my) = (mount.x as f32, mount.y as f32);
         // a reading below range_min (-Inf) means something very close: taken as range_min
         let reading = |r: f32| {
@@ -386,6 +382,15 @@ mod tests {
             };
             let got: Vec<_> = SectorRanges::from_scan(&scan, &mount).points().collect();
             assert_eq!(got, reduce_by_definition(&scan, &mount), "{n} beams");
+            // a scan without beams leaves nothing seen
+            let mut reused = SectorRanges::from_scan(&scan, &mount);
+            let empty = LaserScan {
+                ranges: Vec::new(),
+                ..scan
+            };
+            reused.update(&empty, &mount);
+            assert_eq!(reused.points().count(), 0, "{n} beams, then none");
+            assert!(reused.free_distance(0.0, 0.3).is_infinite());
         }
     }
 
