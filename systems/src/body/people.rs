@@ -7,7 +7,9 @@
 //! Molnár (1995) reduced to three rules: walk straight towards the next route point; slow down
 //! and stop when a robot or another person stands in the walking direction (so it never walks
 //! into a stopped robot on purpose); meanwhile step aside, keeping to the right (to the left when
-//! the right is blocked), and resume once the way is clear. People are part of the world, not
+//! the right is blocked), and resume once the way is clear. A person held up for
+//! [`PATIENCE`] s without getting nearer its next point turns back to the point it came from,
+//! since whoever is in its way may be waiting for it in turn. People are part of the world, not
 //! robots: they read ground truth (everyone's [`TruePose`]) and carry no
 //! [`RobotIndex`](crate::core::RobotIndex), so robot-indexed code (collision counters,
 //! summaries) never sees them.
@@ -39,6 +41,11 @@ const SIDE_PROBE: f64 = 0.3;
 const SIDESTEP: f64 = 0.5;
 /// A route point is reached within this distance (m).
 pub const ARRIVE_TOL: f64 = 0.1;
+/// A person held up by someone in its way that has not come [`PROGRESS`] m nearer its next
+/// route point for this long (s) turns back to the point it came from: a robot may be waiting
+/// for it as it waits for the robot.
+pub const PATIENCE: f64 = 10.0;
+const PROGRESS: f64 = 0.25;
 /// Relative spread of each leg's speed (±), drawn from the person's own stream.
 const SPEED_JITTER: f64 = 0.05;
 
@@ -108,6 +115,8 @@ pub struct Walker {
     pub reached: u32,
     /// A non-looping route is done: the person stays at its last point.
     pub finished: bool,
+    /// The nearest the person has come to its next route point on this leg (m), and when.
+    pub nearest: (f64, f64),
     rng: SimRng,
 }
 
@@ -123,6 +132,7 @@ impl Walker {
             heading: person.start_pose().theta,
             reached: 0,
             finished: person.route.len() < 2,
+            nearest: (f64::INFINITY, 0.0),
             rng,
         }
     }
@@ -194,6 +204,7 @@ pub fn plan_walk(
             .any(|o| (o.x - target[0]).hypot(o.y - target[1]) < r + o.radius + LANE_MARGIN);
     if dist <= ARRIVE_TOL || taken {
         walker.reached += 1;
+        walker.nearest = (f64::INFINITY, now);
         walker.leg_speed = leg_speed(person.speed, &mut walker.rng);
         if walker.next + 1 < n {
             walker.next += 1;
@@ -218,12 +229,30 @@ pub fn plan_walk(
     walker.heading = dy.atan2(dx);
     // land on the point rather than overshoot it
     let speed = walker.leg_speed.min(dist / dt);
+    if dist < walker.nearest.0 - PROGRESS {
+        walker.nearest = (dist, now);
+    }
     let Some(gap) = gap_ahead(p, r, d, others).filter(|g| *g < SLOW_GAP) else {
         walker.velocity = keep_clear(p, r, [d[0] * speed, d[1] * speed], others);
         return;
     };
     // someone is in the way: slow down (to a stop at STOP_GAP) and step aside meanwhile
     let f = ((gap - STOP_GAP) / (SLOW_GAP - STOP_GAP)).clamp(0.0, 1.0);
+    if now - walker.nearest.1 >= PATIENCE {
+        // held up too long: the one in the way may be waiting for us (a robot at a door we
+        // stepped into, or two robots we cannot pass between): walk back the way we came
+        let back = if walker.next > 0 {
+            Some(walker.next - 1)
+        } else {
+            person.looping.then_some(n - 1)
+        };
+        if let Some(back) = back {
+            walker.next = back;
+            walker.nearest = (f64::INFINITY, now);
+            walker.leg_speed = leg_speed(person.speed, &mut walker.rng);
+            return;
+        }
+    }
     let right = [d[1], -d[0]];
     let left = [-d[1], d[0]];
     let side = [right, left].into_iter().find(|s| {
@@ -388,7 +417,7 @@ mod tests {
     }
 
     #[test]
-    fn stops_before_someone_in_a_narrow_way() {
+    fn stops_before_someone_in_a_narrow_way_then_turns_back() {
         // a 1 m corridor along x: no room to step aside
         let mut grid = open_floor();
         for col in 0..200 {
@@ -405,12 +434,23 @@ mod tests {
             y: 0.0,
             radius: 0.3,
         };
-        let path = walk(&person, &[robot], &grid, 400);
-        let end = path[400];
-        let gap = (end[0] - robot.x).hypot(end[1] - robot.y) - 0.3 - person.radius;
+        let path = walk(&person, &[robot], &grid, 600);
+        // 4.45 m to the stop at about 1.2 m/s, slowing down over the last 0.6 m: standing by
+        // 6 s, and still standing at 12 s
+        let stand = path[120];
+        let gap = (stand[0] - robot.x).hypot(stand[1] - robot.y) - 0.3 - person.radius;
         assert!(gap > STOP_GAP - 0.05 && gap < STOP_GAP + 0.1, "gap {gap}");
-        // and it stood still
-        assert!((path[399][0] - end[0]).abs() < 1e-9);
+        assert!((path[240][0] - stand[0]).abs() < 1e-3, "stood still");
+        // held up without progress for PATIENCE s: it walks back to where it came from, and
+        // then tries again
+        let back = 120
+            + path[120..]
+                .iter()
+                .position(|p| p[0] < stand[0] - 1.0)
+                .expect("turned back");
+        let t = back as f64 * 0.05;
+        assert!(t > PATIENCE && t < PATIENCE + 6.0, "turned back at {t} s");
+        assert!(path[600][0] < stand[0], "{:?}", path[600]);
     }
 
     #[test]

@@ -48,6 +48,25 @@ fn hospital_delivery_completes_every_delivery_without_wall_collisions() {
     );
 }
 
+/// hospital_delivery with seed 1, whose people once held two robots for the rest of the run:
+/// the doctor, stepping aside in the north corridor, stood between r4 and r2 (and in r4's way)
+/// until people held up for 10 s began turning back. Every task now completes.
+#[test]
+fn hospital_delivery_seed_1_does_not_jam_between_robots_and_a_person() {
+    let mut sc = sim::scenario::load_scenario(&bundled("hospital_delivery")).expect("loads");
+    sc.seed = 1;
+    let out = run_scenario(&sc, &RunOptions::default()).expect("runs");
+    for (i, r) in out.summary.robots.iter().enumerate() {
+        let n = nav(&out, i);
+        assert!(n.all_tasks_done, "{}: {n:?}", r.name);
+        assert_eq!(n.tasks_failed, 0, "{}: {:?}", r.name, n.failures);
+    }
+    assert!(
+        out.summary.sim_time_s < sc.duration,
+        "ends when all tasks are done"
+    );
+}
+
 /// A closed box inside a room: the goal is free but unreachable.
 const ROOM_WITH_VAULT: &str = r#"
 duration = 30.0
