@@ -3,11 +3,12 @@
 //! the side they face and sorted by position. A scan visits the tiles within range front to back
 //! and skips those that the beams already hitting nearer cannot see past (tested against per-block
 //! maxima of the ranges so far, 16 beams a block). In a visited tile the faces turned towards the
-//! sensor are a prefix or suffix of each group; each is mapped to the beam indices it subtends
-//! (a whole group at once, branch-free so it vectorises) and every beam keeps the nearest exact
-//! ray–face intersection. The first occupied cell a ray enters is entered through such a face, so
-//! results agree with the cell walk of [`super::cast_dda`]. Cost grows with the faces actually
-//! visible, not with the length of the rays.
+//! sensor are a prefix or suffix of each group; they are gathered and mapped to the beam indices
+//! they subtend four at a time (branch-free, so the arctangents vectorise; the tiles' bounding
+//! corners likewise), and every beam keeps the nearest exact ray–face intersection. The first
+//! occupied cell a ray enters is entered through such a face, so results agree with the cell walk
+//! of [`super::cast_dda`]. Cost grows with the faces actually visible, not with the length of the
+//! rays.
 
 use super::fan::Fan;
 use std::f32::consts::TAU;
@@ -52,21 +53,25 @@ fn beam_dirs(start: f32, inc: f32, dirs: &mut [[f32; 4]]) {
         }
         for quad in chunk.chunks_mut(4) {
             for ((d, &dx), &dy) in quad.iter_mut().zip(&xs).zip(&ys) {
-                // one division for both reciprocals, unless a component is (nearly) zero
+                // one division for both reciprocals, unless a component is (nearly) zero;
+                // both ways computed and one selected, so the four beams vectorise
                 let p = dx * dy;
-                *d = if p.abs() > 1e-12 {
-                    let r = 1.0 / p;
-                    [dx, dy, dy * r, dx * r]
-                } else {
-                    let recip = |v: f32| {
-                        if v.abs() < 1e-12 {
-                            f32::INFINITY
-                        } else {
-                            1.0 / v
-                        }
-                    };
-                    [dx, dy, recip(dx), recip(dy)]
+                let r = 1.0 / p;
+                let recip = |v: f32| {
+                    if v.abs() < 1e-12 {
+                        f32::INFINITY
+                    } else {
+                        1.0 / v
+                    }
                 };
+                let (rx, ry) = (recip(dx), recip(dy));
+                let shared = p.abs() > 1e-12;
+                *d = [
+                    dx,
+                    dy,
+                    if shared { dy * r } else { rx },
+                    if shared { dx * r } else { ry },
+                ];
             }
             for i in 0..4 {
                 let nx = xs[i] * c4 - ys[i] * s4;
@@ -90,7 +95,16 @@ const BLOCK: usize = 16;
 struct Scratch {
     dirs: Vec<[f32; 4]>,
     bmax: Vec<f32>,
-    spans: Vec<[i32; 3]>,
+    front: Front,
+}
+
+/// The front faces of one tile, gathered from the four facings: both ends relative to the sensor
+/// in counter-clockwise order (structure of arrays in chunks of four, for the arctangents), and
+/// per face its facing and its line.
+#[derive(Default)]
+struct Front {
+    ends: Vec<[[f32; 4]; 4]>,
+    faces: Vec<(bool, f32, f32, f32)>,
 }
 
 thread_local! {
@@ -110,21 +124,26 @@ fn any_beyond(fan: &Fan, out: &[f32], bmax: &[f32], lo: f32, width: f32, near: f
     })
 }
 
-/// Occlusion test of a tile (centre offset (cx, cy) from the sensor, half side `h`): false if
-/// its nearest point lies beyond `horizon` (the longest range any beam still has) or if every
-/// beam that can cross it already hit something nearer. The beams that can cross it are those
-/// between the two corners that bound it as seen from the sensor; a tile holding the sensor is
-/// always visible.
+/// A tile that may be visible: its index, its centre's offset from the sensor's tile centre
+/// (`d`, for the early end), the distance from the sensor to its nearest point, and the two
+/// corners that bound it as seen from the sensor (counter-clockwise: start x, y, end x, y);
+/// `inside` when the sensor is in it.
+#[derive(Clone, Copy, Default)]
+struct Candidate {
+    tile: usize,
+    d: f32,
+    near: f32,
+    ends: [f32; 4],
+    inside: bool,
+}
+
+/// The nearest distance and bounding corners of the tile centred at (cx, cy) from the sensor,
+/// half side `h`.
 #[inline]
-fn visible(fan: &Fan, out: &[f32], bmax: &[f32], cx: f32, cy: f32, h: f32, horizon: f32) -> bool {
+fn candidate(tile: usize, d: f32, cx: f32, cy: f32, h: f32) -> Candidate {
     let (qx, qy) = (cx.abs() - h, cy.abs() - h);
-    if qx <= 0.0 && qy <= 0.0 {
-        return true;
-    }
+    let inside = qx <= 0.0 && qy <= 0.0;
     let near = (qx.max(0.0).powi(2) + qy.max(0.0).powi(2)).sqrt();
-    if near > horizon {
-        return false;
-    }
     let (x0, x1, y0, y1) = (cx - h, cx + h, cy - h, cy + h);
     // the corner the arc starts from (counter-clockwise) and the one it ends at
     let ((sx, sy), (ex, ey)) = if x0 > 0.0 {
@@ -148,10 +167,13 @@ fn visible(fan: &Fan, out: &[f32], bmax: &[f32], cx: f32, cy: f32, h: f32, horiz
     } else {
         ((x0, y1), (x1, y1))
     };
-    let first = atan2_approx(sy, sx);
-    let mut width = atan2_approx(ey, ex) - first;
-    width += if width < 0.0 { TAU } else { 0.0 };
-    any_beyond(fan, out, bmax, first - MARGIN, width + 2.0 * MARGIN, near)
+    Candidate {
+        tile,
+        d,
+        near,
+        ends: [sx, sy, ex, ey],
+        inside,
+    }
 }
 
 /// An axis-aligned face in grid-relative metres: the line `axis = at` between `lo` and `hi`
@@ -324,7 +346,7 @@ impl Faces {
             return;
         }
         let fan = Fan::new(start, inc, n);
-        let Scratch { dirs, bmax, spans } = scratch;
+        let Scratch { dirs, bmax, front } = scratch;
         bmax.clear();
         bmax.resize(n.div_ceil(BLOCK), f32::INFINITY);
         dirs.resize(n, [0.0; 4]);
@@ -346,55 +368,99 @@ impl Faces {
         // tiles are visited front to back: once every beam has hit something nearer than the
         // next ones, the scan is complete
         let mut horizon = max_range;
-        for &(ox, oy, d) in &self.offsets {
-            if d - 2.0 * half_diag > horizon {
-                break;
-            }
-            let (tx, ty) = (ptx + ox as i32, pty + oy as i32);
-            if tx < 0 || ty < 0 || tx >= self.tw as i32 || ty >= self.th as i32 {
-                continue;
-            }
-            let tile = &self.tiles[ty as usize * self.tw + tx as usize];
-            if tile.faces.is_empty() {
-                continue;
-            }
-            let cx = (tx as f32 + 0.5) * tsize - gx;
-            let cy = (ty as f32 + 0.5) * tsize - gy;
-            if half_plane && cx * mx + cy * my < -half_diag {
-                continue;
-            }
-            if !visible(&fan, out, bmax, cx, cy, tsize / 2.0, horizon) {
-                continue;
-            }
-            let (mut k0, mut k1) = (usize::MAX, 0);
-            let group =
-                |j: usize| &tile.faces[tile.groups[j] as usize..tile.groups[j + 1] as usize];
-            // front faces: x = at facing +x when at < gx, facing −x when at > gx (y alike)
-            let front = |j: usize, g: f32| {
-                let f = group(j);
-                if j == 0 || j == 2 {
-                    &f[..f.partition_point(|f| f.at < g)]
-                } else {
-                    &f[f.partition_point(|f| f.at <= g)..]
+        // tiles that pass the cheap tests are taken four at a time, so that the arctangents of
+        // their bounding corners are computed together; each is then tested for occlusion and
+        // drawn in turn, front to back as before
+        let mut offsets = self.offsets.iter();
+        let mut batch = [Candidate::default(); 4];
+        let mut more = true;
+        'scan: while more {
+            let mut m = 0;
+            while m < 4 {
+                let Some(&(ox, oy, d)) = offsets.next() else {
+                    more = false;
+                    break;
+                };
+                if d - 2.0 * half_diag > horizon {
+                    more = false;
+                    break;
                 }
-            };
-            beams.draw::<0>(front(0, gx), spans, dirs, out, &mut k0, &mut k1);
-            beams.draw::<1>(front(1, gx), spans, dirs, out, &mut k0, &mut k1);
-            beams.draw::<2>(front(2, gy), spans, dirs, out, &mut k0, &mut k1);
-            beams.draw::<3>(front(3, gy), spans, dirs, out, &mut k0, &mut k1);
-            if k0 <= k1 {
-                // the touched beams' blocks get exact bounds again
-                for b in k0 / BLOCK..=k1 / BLOCK {
-                    let end = (b * BLOCK + BLOCK).min(n);
-                    bmax[b] = out[b * BLOCK..end].iter().fold(0.0f32, |m, &x| m.max(x));
+                let (tx, ty) = (ptx + ox as i32, pty + oy as i32);
+                if tx < 0 || ty < 0 || tx >= self.tw as i32 || ty >= self.th as i32 {
+                    continue;
                 }
-                horizon = bmax.iter().fold(0.0f32, |m, &r| m.max(r)).min(max_range);
+                let t = ty as usize * self.tw + tx as usize;
+                if self.tiles[t].faces.is_empty() {
+                    continue;
+                }
+                let cx = (tx as f32 + 0.5) * tsize - gx;
+                let cy = (ty as f32 + 0.5) * tsize - gy;
+                if half_plane && cx * mx + cy * my < -half_diag {
+                    continue;
+                }
+                let c = candidate(t, d, cx, cy, tsize / 2.0);
+                if c.inside || c.near <= horizon {
+                    batch[m] = c;
+                    m += 1;
+                }
+            }
+            let mut arcs = [[0.0f32; 2]; 4];
+            for (a, c) in arcs.iter_mut().zip(&batch) {
+                let [sx, sy, ex, ey] = c.ends;
+                let first = atan2_approx(sy, sx);
+                let mut width = atan2_approx(ey, ex) - first;
+                width += if width < 0.0 { TAU } else { 0.0 };
+                *a = [first, width];
+            }
+            for (c, &[first, width]) in batch[..m].iter().zip(&arcs) {
+                // a tile whose nearest point lies beyond the longest range any beam still has
+                // is hidden, and so is every later one once their centres are that far
+                if c.d - 2.0 * half_diag > horizon {
+                    break 'scan;
+                }
+                // a tile is hidden if every beam that can cross it (those between the two
+                // corners that bound it) already hit something nearer; the one holding the
+                // sensor is always visible
+                if !c.inside
+                    && (c.near > horizon
+                        || !any_beyond(
+                            &fan,
+                            out,
+                            bmax,
+                            first - MARGIN,
+                            width + 2.0 * MARGIN,
+                            c.near,
+                        ))
+                {
+                    continue;
+                }
+                let tile = &self.tiles[c.tile];
+                let (mut k0, mut k1) = (usize::MAX, 0);
+                let group =
+                    |j: usize| &tile.faces[tile.groups[j] as usize..tile.groups[j + 1] as usize];
+                // front faces: x = at facing +x when at < gx, facing −x when at > gx (y alike)
+                let f0 = group(0);
+                let f1 = group(1);
+                let f2 = group(2);
+                let f3 = group(3);
+                let f0 = &f0[..f0.partition_point(|f| f.at < gx)];
+                let f1 = &f1[f1.partition_point(|f| f.at <= gx)..];
+                let f2 = &f2[..f2.partition_point(|f| f.at < gy)];
+                let f3 = &f3[f3.partition_point(|f| f.at <= gy)..];
+                beams.gather(front, [f0, f1, f2, f3]);
+                beams.draw(front, dirs, out, &mut k0, &mut k1);
+                if k0 <= k1 {
+                    // the touched beams' blocks get exact bounds again
+                    for b in k0 / BLOCK..=k1 / BLOCK {
+                        let end = (b * BLOCK + BLOCK).min(n);
+                        bmax[b] = out[b * BLOCK..end].iter().fold(0.0f32, |m, &x| m.max(x));
+                    }
+                    horizon = bmax.iter().fold(0.0f32, |m, &r| m.max(r)).min(max_range);
+                }
             }
         }
         for o in out.iter_mut() {
-            if *o > max_range {
-                *o = f32::INFINITY;
-            }
+            *o = if *o > max_range { f32::INFINITY } else { *o };
         }
     }
 }
@@ -410,77 +476,102 @@ struct Beams {
 }
 
 impl Beams {
-    /// Intersects the front faces of facing `J` with the beams they subtend, keeping the nearest
-    /// hit per beam; the beams looked at widen [k0, k1]. First every face's interval of beam
-    /// indices (branch-free over the faces, so it vectorises), then the beams of each.
-    #[allow(clippy::too_many_arguments)]
+    /// Gathers the front faces of a tile, facing by facing (0: x = at facing +x, 1: facing −x,
+    /// 2: y = at facing +y, 3: facing −y), relative to the sensor.
     #[inline]
-    fn draw<const J: usize>(
+    fn gather(&self, front: &mut Front, groups: [&[Face]; FACINGS]) {
+        front.faces.clear();
+        let m: usize = groups.iter().map(|g| g.len()).sum();
+        front.ends.clear();
+        front
+            .ends
+            .resize(m.div_ceil(4), [[1.0; 4], [0.0; 4], [1.0; 4], [0.0; 4]]);
+        let mut i = 0;
+        for (j, faces) in groups.into_iter().enumerate() {
+            let vertical = j < 2;
+            let (g_at, g_along) = if vertical {
+                (self.gx, self.gy)
+            } else {
+                (self.gy, self.gx)
+            };
+            for f in faces {
+                let (p_at, p_lo, p_hi) = (f.at - g_at, f.lo - g_along, f.hi - g_along);
+                // counter-clockwise, the face runs from its lo end to its hi end when it is to
+                // the right of the sensor (facing −x) or below it (facing +y), from hi to lo
+                // otherwise
+                let (a, b) = if j == 1 || j == 2 {
+                    (p_lo, p_hi)
+                } else {
+                    (p_hi, p_lo)
+                };
+                let ((ax, ay), (bx, by)) = if vertical {
+                    ((p_at, a), (p_at, b))
+                } else {
+                    ((a, p_at), (b, p_at))
+                };
+                let e = &mut front.ends[i / 4];
+                e[0][i % 4] = ax;
+                e[1][i % 4] = ay;
+                e[2][i % 4] = bx;
+                e[3][i % 4] = by;
+                front.faces.push((vertical, p_at, p_lo, p_hi));
+                i += 1;
+            }
+        }
+    }
+
+    /// Intersects the gathered front faces with the beams they subtend, keeping the nearest hit
+    /// per beam; the beams looked at widen [k0, k1]. First every face's interval of beam indices
+    /// (branch-free, four faces at a time), then the beams of each.
+    #[inline]
+    fn draw(
         &self,
-        faces: &[Face],
-        spans: &mut Vec<[i32; 3]>,
+        front: &Front,
         dirs: &[[f32; 4]],
         out: &mut [f32],
         k0: &mut usize,
         k1: &mut usize,
     ) {
-        if faces.is_empty() {
-            return;
-        }
-        let vertical = J < 2;
-        let (g_at, g_along) = if vertical {
-            (self.gx, self.gy)
-        } else {
-            (self.gy, self.gx)
-        };
-        spans.clear();
-        spans.resize(faces.len(), [0; 3]);
         let turn = TAU * self.inv_inc;
         let last = self.n as i32 - 1;
-        for (f, sp) in faces.iter().zip(spans.iter_mut()) {
-            let (p_at, p_lo, p_hi) = (f.at - g_at, f.lo - g_along, f.hi - g_along);
-            let (a_lo, a_hi) = if vertical {
-                (atan2_approx(p_lo, p_at), atan2_approx(p_hi, p_at))
-            } else {
-                (atan2_approx(p_at, p_lo), atan2_approx(p_at, p_hi))
-            };
-            // counter-clockwise, the face runs from its lo end to its hi end when it is to the
-            // right of the sensor (J = 1) or below it (J = 2), from hi to lo otherwise
-            let (first, mut width) = if J == 1 || J == 2 {
-                (a_lo, a_hi - a_lo)
-            } else {
-                (a_hi, a_lo - a_hi)
-            };
-            width += if width < 0.0 { TAU } else { 0.0 };
-            let mut rel = first - MARGIN - self.start;
-            rel += if rel < 0.0 { TAU } else { 0.0 };
-            rel += if rel < 0.0 { TAU } else { 0.0 };
-            // beams ⌈u0⌉ ..= ⌊u1⌋, and 0 ..= ⌊u1 − turn⌋ if the interval crosses 2π back into
-            // the fan (u0 ≥ 0, so truncation is floor; ceil by hand: no SSE4.1 rounding)
-            // (bounded, so the conversions below cannot overflow however fine the fan)
-            let u0 = (rel * self.inv_inc).min(1e9);
-            let u1 = ((rel + width + 2.0 * MARGIN) * self.inv_inc).min(1e9);
-            let r0 = u0 as i32 + ((u0 as i32 as f32) < u0) as i32;
-            let wrapped = if u1 >= turn { (u1 - turn) as i32 } else { -1 };
-            *sp = [r0, (u1 as i32).min(last), wrapped.min(last)];
-        }
-        let (ia, ib) = if vertical { (2, 1) } else { (3, 0) };
-        for (f, &[r0, r1, wrapped]) in faces.iter().zip(spans.iter()) {
-            let (p_at, p_lo, p_hi) = (f.at - g_at, f.lo - g_along, f.hi - g_along);
-            for (r0, r1) in [(r0, r1), (0, wrapped)] {
-                if r0 > r1 {
-                    continue;
+        for (c, e) in front.ends.iter().enumerate() {
+            let mut spans = [[0i32; 3]; 4];
+            for l in 0..4 {
+                let first = atan2_approx(e[1][l], e[0][l]);
+                let mut width = atan2_approx(e[3][l], e[2][l]) - first;
+                width += if width < 0.0 { TAU } else { 0.0 };
+                let mut rel = first - MARGIN - self.start;
+                rel += if rel < 0.0 { TAU } else { 0.0 };
+                rel += if rel < 0.0 { TAU } else { 0.0 };
+                // beams ⌈u0⌉ ..= ⌊u1⌋, and 0 ..= ⌊u1 − turn⌋ if the interval crosses 2π back
+                // into the fan (u0 ≥ 0, so truncation is floor; ceil by hand: no SSE4.1
+                // rounding; bounded, so the conversions cannot overflow however fine the fan)
+                let u0 = (rel * self.inv_inc).min(1e9);
+                let u1 = ((rel + width + 2.0 * MARGIN) * self.inv_inc).min(1e9);
+                let r0 = u0 as i32 + ((u0 as i32 as f32) < u0) as i32;
+                let wrapped = if u1 >= turn { (u1 - turn) as i32 } else { -1 };
+                spans[l] = [r0, (u1 as i32).min(last), wrapped.min(last)];
+            }
+            for (&(vertical, p_at, p_lo, p_hi), &[r0, r1, wrapped]) in
+                front.faces[c * 4..].iter().zip(&spans)
+            {
+                let (ia, ib) = if vertical { (2, 1) } else { (3, 0) };
+                for (r0, r1) in [(r0, r1), (0, wrapped)] {
+                    if r0 > r1 {
+                        continue;
+                    }
+                    let (r0, r1) = (r0 as usize, r1 as usize);
+                    // branch-free: whether a beam hits the face nearer than before is
+                    // unpredictable
+                    for (d, o) in dirs[r0..=r1].iter().zip(&mut out[r0..=r1]) {
+                        let t = p_at * d[ia];
+                        let s = t * d[ib];
+                        let hit = t >= 0.0 && t < *o && s >= p_lo && s <= p_hi;
+                        *o = if hit { t } else { *o };
+                    }
+                    *k0 = (*k0).min(r0);
+                    *k1 = (*k1).max(r1);
                 }
-                let (r0, r1) = (r0 as usize, r1 as usize);
-                // branch-free: whether a beam hits the face nearer than before is unpredictable
-                for (d, o) in dirs[r0..=r1].iter().zip(&mut out[r0..=r1]) {
-                    let t = p_at * d[ia];
-                    let s = t * d[ib];
-                    let hit = t >= 0.0 && t < *o && s >= p_lo && s <= p_hi;
-                    *o = if hit { t } else { *o };
-                }
-                *k0 = (*k0).min(r0);
-                *k1 = (*k1).max(r1);
             }
         }
     }
