@@ -14,7 +14,7 @@
 use super::footprint::Footprint;
 use super::kinematics::{DriveCommand, DriveState, Kinematics, integrate_arc};
 use super::people::Walker;
-use crate::core::{Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
+use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
 use crate::world::{StaticWorld, rects::tile_rects};
 use bevy_ecs::prelude::*;
 use rapier2d::prelude::*;
@@ -314,12 +314,15 @@ fn widen_broad_phase_skin(p: &mut IntegrationParameters) {
 type Pose2d = rapier2d::math::Pose;
 
 /// Physics: drive every robot along its commanded arc and every person at its planned velocity,
-/// resolve contacts, read back ground truth.
+/// resolve contacts, read back ground truth. The per-robot arithmetic before and after the
+/// (serial) rapier step runs on the kernel pool: only the hand-over of velocities to rapier is
+/// serial. Each robot's values come from its own state only, so threads do not change results.
 #[allow(clippy::type_complexity)]
 pub fn physics_step(
     mut physics: ResMut<Physics>,
     mut world: ResMut<StaticWorld>,
     clock: Res<SimClock>,
+    pool: Res<KernelPool>,
     mut robots: Query<(
         &PhysicsBody,
         &Kinematics,
@@ -335,26 +338,36 @@ pub fn physics_step(
         physics.rebuild_tile(&world, tx, ty);
     }
     let dt = clock.dt;
-    for (body, kin, cmd, mut state, mut truth, _) in robots.iter_mut() {
-        let (v, w) = kin.step(cmd, &mut state, dt);
-        let current = match physics.world.bodies.get(body.0) {
-            Some(b) => {
-                let t = b.translation();
-                Pose2::new(t.x as f64, t.y as f64, b.rotation().angle() as f64)
-            }
-            None => truth.pose,
-        };
-        truth.prev = current;
-        let target = integrate_arc(&current, v, w, dt);
-        if let Some(b) = physics.world.bodies.get_mut(body.0) {
-            b.set_linvel(
+    let mut jobs: Vec<_> = robots
+        .iter_mut()
+        .map(|(body, kin, cmd, state, truth, twist)| (*body, kin, cmd, state, truth, twist, None))
+        .collect();
+    {
+        let bodies = &physics.world.bodies;
+        pool.for_each(&mut jobs, |(body, kin, cmd, state, truth, _, vel)| {
+            let (v, w) = kin.step(cmd, state, dt);
+            let current = match bodies.get(body.0) {
+                Some(b) => {
+                    let t = b.translation();
+                    Pose2::new(t.x as f64, t.y as f64, b.rotation().angle() as f64)
+                }
+                None => truth.pose,
+            };
+            truth.prev = current;
+            let target = integrate_arc(&current, v, w, dt);
+            *vel = Some((
                 Vector::new(
                     ((target.x - current.x) / dt) as Real,
                     ((target.y - current.y) / dt) as Real,
                 ),
-                true,
-            );
-            b.set_angvel((w) as Real, true);
+                w as Real,
+            ));
+        });
+    }
+    for (body, .., vel) in &jobs {
+        if let (Some(b), Some((linvel, angvel))) = (physics.world.bodies.get_mut(body.0), vel) {
+            b.set_linvel(*linvel, true);
+            b.set_angvel(*angvel, true);
         }
     }
     for (body, walker, mut truth) in people.iter_mut() {
@@ -375,8 +388,9 @@ pub fn physics_step(
             truth.pose = Pose2::new(t.x as f64, t.y as f64, walker.heading);
         }
     }
-    for (body, _, _, _, mut truth, mut twist) in robots.iter_mut() {
-        if let Some(b) = physics.world.bodies.get(body.0) {
+    let bodies = &physics.world.bodies;
+    pool.for_each(&mut jobs, |(body, _, _, _, truth, twist, _)| {
+        if let Some(b) = bodies.get(body.0) {
             let t = b.translation();
             let pose = Pose2::new(t.x as f64, t.y as f64, b.rotation().angle() as f64);
             let d = truth.prev.between(&pose);
@@ -384,7 +398,7 @@ pub fn physics_step(
             twist.w = wrap_angle(pose.theta - truth.prev.theta) / dt;
             truth.pose = pose;
         }
-    }
+    });
 }
 
 pub struct PhysicsPlugin;

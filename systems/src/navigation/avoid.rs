@@ -54,8 +54,30 @@ struct BeamSectors {
     /// (sector, first beam, end beam) of each run of consecutive beams in one sector, in beam
     /// order (a fan crossing 2π visits a sector in two runs).
     runs: Vec<(u32, u32, u32)>,
-    /// Scratch: each beam's squared distance from the robot's centre in the current scan.
+    /// The runs in sector order, when no sector is seen in two runs (a fan that does not cross
+    /// 2π into its own start): then each run is one point of the list, written in order.
+    by_sector: Option<Vec<u32>>,
+    /// Scratch: each beam's squared distance from the robot's centre in the current scan, and
+    /// its point.
     d2: Vec<f32>,
+    px: Vec<f32>,
+    py: Vec<f32>,
+}
+
+/// The nearest beam of the run [start, end) without a branch on the readings (whether a beam is
+/// lost or nearer than the one before is a coin toss in a real scan): its squared distance
+/// (+Inf when the run saw nothing; on a tie the first beam) and its point.
+#[inline(always)]
+fn nearest_in_run(d2: &[f32], px: &[f32], py: &[f32], start: u32, end: u32) -> (f32, f32, f32) {
+    let (start, end) = (start as usize, end as usize);
+    let (mut bd, mut bk) = (f32::INFINITY, start);
+    for (k, &d) in d2[start..end].iter().enumerate() {
+        let k = start + k;
+        let nearer = d < bd;
+        bd = if nearer { d } else { bd };
+        bk = if nearer { k } else { bk };
+    }
+    (bd, px[bk], py[bk])
 }
 
 impl BeamSectors {
@@ -86,7 +108,15 @@ impl BeamSectors {
                 _ => self.runs.push((sector as u32, k as u32, k as u32 + 1)),
             }
         }
+        let mut order: Vec<u32> = (0..self.runs.len() as u32).collect();
+        order.sort_by_key(|&i| self.runs[i as usize].0);
+        let distinct = order
+            .windows(2)
+            .all(|w| self.runs[w[0] as usize].0 != self.runs[w[1] as usize].0);
+        self.by_sector = distinct.then_some(order);
         self.d2 = vec![0.0; n];
+        self.px = vec![0.0; n];
+        self.py = vec![0.0; n];
     }
 }
 
@@ -125,51 +155,84 @@ impl SectorRanges {
                 r
             }
         };
-        // every beam's squared distance from the centre, as one vectorized pass; a lost beam
-        // (+Inf, NaN) gives +Inf or NaN, which never compares below anything
+        // every beam's point and squared distance from the centre, as one vectorized pass; a
+        // lost beam (+Inf, NaN) gives +Inf or NaN, which never compares below anything
         let BeamSectors {
-            cos, sin, runs, d2, ..
+            cos,
+            sin,
+            runs,
+            by_sector,
+            d2,
+            px,
+            py,
+            ..
         } = table;
-        for (((d, &r), &c), &s) in d2.iter_mut().zip(&scan.ranges).zip(&*cos).zip(&*sin) {
+        for (((((d, x), y), &r), &c), &s) in d2
+            .iter_mut()
+            .zip(px.iter_mut())
+            .zip(py.iter_mut())
+            .zip(&scan.ranges)
+            .zip(&*cos)
+            .zip(&*sin)
+        {
             let r = reading(r);
-            let (px, py) = (mx + c * r, my + s * r);
-            *d = px * px + py * py;
+            (*x, *y) = (mx + c * r, my + s * r);
+            *d = *x * *x + *y * *y;
         }
-        // the nearest beam of each run without a branch on the readings (whether a beam is
-        // lost or nearer than the one before is a coin toss in a real scan); one slot more than
-        // there are sectors, for a run that is not nearer than its sector's best (a sector
-        // seen in two runs, when the fan crosses 2π, keeps the nearer, on a tie the earlier)
-        const DISCARD: usize = SECTORS;
-        let mut best = [f32::INFINITY; SECTORS + 1];
-        let mut nearest = [(0f32, 0f32); SECTORS + 1];
-        for &(sector, start, end) in runs.iter() {
-            let (start, end) = (start as usize, end as usize);
-            let (mut bd, mut bk) = (f32::INFINITY, start);
-            for (k, &d) in d2[start..end].iter().enumerate() {
-                let k = start + k;
-                let nearer = d < bd;
-                bd = if nearer { d } else { bd };
-                bk = if nearer { k } else { bk };
-            }
-            let i = sector as usize;
-            let slot = if bd < best[i] { i } else { DISCARD };
-            let r = reading(scan.ranges[bk]);
-            best[slot] = bd;
-            nearest[slot] = (mx + cos[bk] * r, my + sin[bk] * r);
-        }
-        // the list of the sectors that saw something, compacted without a branch either:
-        // every sector's point is written at the end of the list, which only grows past a
-        // sector that saw something
+        let (d2, px, py) = (&d2[..], &px[..], &py[..]);
+        let nearest_of = |start: u32, end: u32| nearest_in_run(d2, px, py, start, end);
         let mut len = 0;
-        for (&d, &(x, y)) in best[..SECTORS].iter().zip(&nearest[..SECTORS]) {
-            self.xs[len] = x;
-            self.ys[len] = y;
-            len += d.is_finite() as usize;
+        if let Some(order) = by_sector {
+            // one run per sector: the runs' points in sector order, each written at the end of
+            // the list, which only grows past a run that saw something
+            for &i in order.iter() {
+                let (_, start, end) = runs[i as usize];
+                let (d, x, y) = nearest_of(start, end);
+                self.xs[len] = x;
+                self.ys[len] = y;
+                len += d.is_finite() as usize;
+            }
+        } else {
+            // a sector seen in two runs (the fan crosses 2π) keeps the nearer, on a tie the
+            // earlier: the runs go into per-sector slots, with one slot more than there are
+            // sectors for a run that is not nearer than its sector's best
+            const DISCARD: usize = SECTORS;
+            let mut best = [f32::INFINITY; SECTORS + 1];
+            let mut nearest = [(0f32, 0f32); SECTORS + 1];
+            for &(sector, start, end) in runs.iter() {
+                let (bd, x, y) = nearest_of(start, end);
+                let i = sector as usize;
+                let slot = if bd < best[i] { i } else { DISCARD };
+                best[slot] = bd;
+                nearest[slot] = (x, y);
+            }
+            // the sectors that saw something, compacted without a branch either
+            for (&d, &(x, y)) in best[..SECTORS].iter().zip(&nearest[..SECTORS]) {
+                self.xs[len] = x;
+                self.ys[len] = y;
+                len += d.is_finite() as usize;
+            }
         }
         self.len = len;
         let end = len.next_multiple_of(LANES);
         self.xs[len..end].fill(f32::NAN);
         self.ys[len..end].fill(f32::NAN);
+    }
+
+    /// The points nearer than `sqrt(limit2)` (a copy, compacted without a branch).
+    fn within(&self, limit2: f32) -> SectorRanges {
+        let mut near = SectorRanges::default();
+        let mut len = 0;
+        for (&x, &y) in self.xs[..self.len].iter().zip(&self.ys[..self.len]) {
+            near.xs[len] = x;
+            near.ys[len] = y;
+            len += (x * x + y * y < limit2) as usize;
+        }
+        near.len = len;
+        let end = len.next_multiple_of(LANES);
+        near.xs[len..end].fill(f32::NAN);
+        near.ys[len..end].fill(f32::NAN);
+        near
     }
 
     /// The seen points (base frame), in sector order.
@@ -216,34 +279,64 @@ impl SectorRanges {
         needed: f64,
         max_dev: f64,
     ) -> (f64, f64) {
-        let step = 5f64.to_radians();
-        let n = (max_dev / step).floor() as i32;
         let hw = half_width as f32;
         let (uy, ux) = wanted.sin_cos();
-        let mut best_open = (wanted, self.free_along(ux, uy, hw) as f64);
-        if best_open.1 >= needed {
-            return best_open;
+        let ahead = self.free_along(ux, uy, hw) as f64;
+        if ahead >= needed || !needed.is_finite() {
+            return (wanted, ahead);
         }
-        // the candidates' directions by rotating the wanted one 5° at a time each way (no
-        // trigonometry per candidate; the rounding after 36 steps is far below a microradian)
-        let (ss, cs) = step.sin_cos();
-        let (mut left, mut right) = ((ux, uy), (ux, uy));
-        for k in 1..=n {
-            left = (left.0 * cs - left.1 * ss, left.0 * ss + left.1 * cs);
-            right = (right.0 * cs + right.1 * ss, -right.0 * ss + right.1 * cs);
-            for (sign, (dx, dy)) in [(1.0, left), (-1.0, right)] {
-                let h = wanted + sign * k as f64 * step;
-                let f = self.free_along(dx, dy, hw) as f64;
-                if f >= needed {
-                    return (h, f);
-                }
-                if f > best_open.1 {
-                    best_open = (h, f);
-                }
+        // a point blocks a heading at its distance along it, and its distance across is under
+        // the half width: so only points nearer than √(needed² + hw²) can block one short of
+        // `needed` (with a margin far above rounding). The candidates are tested on those
+        // alone: a shorter free distance found there is the free distance, to the bit, and the
+        // heading that is free enough gets its distance over all points
+        let reach2 = (needed as f32 * 1.001 + 0.01).powi(2) + (hw + 0.01).powi(2);
+        let near = self.within(reach2);
+        choose_among(
+            wanted,
+            ahead,
+            needed,
+            max_dev,
+            |dx, dy| near.free_along(dx, dy, hw) as f64,
+            |dx, dy| self.free_along(dx, dy, hw) as f64,
+        )
+    }
+}
+
+/// The candidate search of [`SectorRanges::choose_heading`] once the wanted heading (free for
+/// `ahead`) fell short: `test` gives a candidate's free distance when it is short of `needed`
+/// (anything at least `needed` otherwise), `exact` its free distance.
+fn choose_among(
+    wanted: f64,
+    ahead: f64,
+    needed: f64,
+    max_dev: f64,
+    test: impl Fn(f64, f64) -> f64,
+    exact: impl Fn(f64, f64) -> f64,
+) -> (f64, f64) {
+    let step = 5f64.to_radians();
+    let n = (max_dev / step).floor() as i32;
+    let (uy, ux) = wanted.sin_cos();
+    let mut best_open = (wanted, ahead);
+    // the candidates' directions by rotating the wanted one 5° at a time each way (no
+    // trigonometry per candidate; the rounding after 36 steps is far below a microradian)
+    let (ss, cs) = step.sin_cos();
+    let (mut left, mut right) = ((ux, uy), (ux, uy));
+    for k in 1..=n {
+        left = (left.0 * cs - left.1 * ss, left.0 * ss + left.1 * cs);
+        right = (right.0 * cs + right.1 * ss, -right.0 * ss + right.1 * cs);
+        for (sign, (dx, dy)) in [(1.0, left), (-1.0, right)] {
+            let h = wanted + sign * k as f64 * step;
+            let f = test(dx, dy);
+            if f >= needed {
+                return (h, exact(dx, dy));
+            }
+            if f > best_open.1 {
+                best_open = (h, f);
             }
         }
-        best_open
     }
+    best_open
 }
 
 #[cfg(test)]
@@ -312,6 +405,67 @@ mod tests {
             .map(|k| s.free_distance((k as f64 * 5.0).to_radians(), 0.3))
             .fold(0.0, f64::max);
         assert!(h.abs() > 2.0 && (f - most).abs() < 1e-4, "{h} {f} {most}");
+    }
+
+    /// The choice as its doc reads: every candidate's free distance over all the points.
+    fn choose_by_definition(
+        s: &SectorRanges,
+        wanted: f64,
+        hw: f64,
+        needed: f64,
+        max_dev: f64,
+    ) -> (f64, f64) {
+        let (uy, ux) = wanted.sin_cos();
+        let ahead = s.free_along(ux, uy, hw as f32) as f64;
+        if ahead >= needed {
+            return (wanted, ahead);
+        }
+        let all = |dx, dy| s.free_along(dx, dy, hw as f32) as f64;
+        choose_among(wanted, ahead, needed, max_dev, all, all)
+    }
+
+    /// Testing the candidates on the near points only picks the same heading with the same
+    /// free distance, to the bit, as testing them on all points.
+    #[test]
+    fn the_choice_on_near_points_is_the_choice_on_all() {
+        let mut rng = crate::core::stream_rng(7, "avoid", "choice");
+        let mut next = || rand::RngExt::random::<f64>(&mut rng);
+        let mut differing_paths = 0;
+        for case in 0..400 {
+            let n = 180;
+            let ranges = (0..n)
+                .map(|_| match (next() * 10.0) as u32 {
+                    0 => f32::INFINITY,
+                    1 => f32::NEG_INFINITY,
+                    _ => (0.2 + next() * 4.0) as f32,
+                })
+                .collect();
+            let scan = LaserScan {
+                stamp: 0.0,
+                angle_min: -PI as f32 / 2.0,
+                angle_increment: (PI / 179.0) as f32,
+                range_min: 0.05,
+                range_max: 8.0,
+                ranges,
+            };
+            let s = SectorRanges::from_scan(&scan, &Pose2::new(0.1, 0.0, 0.0));
+            let wanted = (next() - 0.5) * 2.0;
+            let needed = 0.5 + next() * 5.0;
+            let hw = 0.2 + next() * 0.3;
+            let got = s.choose_heading(wanted, hw, needed, PI * 0.8);
+            let want = choose_by_definition(&s, wanted, hw, needed, PI * 0.8);
+            assert_eq!(
+                (got.0.to_bits(), got.1.to_bits()),
+                (want.0.to_bits(), want.1.to_bits()),
+                "case {case}"
+            );
+            differing_paths += usize::from(got.1 < needed);
+        }
+        // both outcomes occur: a heading free enough, and the most open one
+        assert!(
+            differing_paths > 10 && differing_paths < 390,
+            "{differing_paths}"
+        );
     }
 
     /// The reduction beam by beam into the sectors' slots, as the definition reads.

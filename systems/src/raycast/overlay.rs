@@ -56,11 +56,24 @@ pub fn overlay_circles(
     circles: &[[f32; 3]],
 ) {
     let beams = Beams::new(start, increment, out.len());
+    // a fan of at most half a turn (counter-clockwise) sees nothing wholly behind the line
+    // through the sensor across its central direction: such circles skip their arcsine and
+    // arctangent (the margin is far above the rounding of a beam's direction)
+    let span = beams.fan.span();
+    let axis = (increment > 0.0 && span <= PI).then(|| {
+        let (s, c) = (start + span / 2.0).sin_cos();
+        (c, s)
+    });
     for &[cx, cy, r] in circles {
         let (vx, vy) = (cx - p[0], cy - p[1]);
         let d2 = vx * vx + vy * vy;
         if d2 <= r * r {
             out.iter_mut().for_each(|o| *o = 0.0);
+            continue;
+        }
+        if let Some((ax, ay)) = axis
+            && vx * ax + vy * ay < -(r + 1e-3)
+        {
             continue;
         }
         let d = d2.sqrt();

@@ -263,6 +263,56 @@ fn edge_cases() {
     assert!((rm.cast([5.0, 5.0], 0.0, 4.95) - 4.9).abs() < 1e-4);
 }
 
+/// Fans of up to half a turn skip circles wholly behind the sensor without missing one: every
+/// beam agrees with the analytic distance to the nearest circle, also for circles just behind,
+/// on or just in front of the line across the fan's central direction.
+#[test]
+fn half_turn_fans_see_every_circle_in_front() {
+    let mut rng = crate::core::stream_rng(7, "overlay", "circles");
+    let mut next = || rand::RngExt::random::<f32>(&mut rng);
+    for (n, fov) in [(181usize, PI), (91, PI / 2.0), (181, PI - 1e-3)] {
+        let inc = fov / (n - 1) as f32;
+        for _ in 0..200 {
+            let start = next() * 2.0 * PI - PI;
+            let (s, c) = (start + fov / 2.0).sin_cos();
+            let p = [next() * 4.0 - 2.0, next() * 4.0 - 2.0];
+            // circles placed relative to the line across the central direction: behind it,
+            // straddling it, in front of it, at every lateral offset
+            let circles: Vec<[f32; 3]> = (0..12)
+                .map(|_| {
+                    let r = 0.1 + next() * 0.4;
+                    let ahead = -r + (next() - 0.5) * 0.02 + (next() - 0.5) * 2.0 * next();
+                    let side = (next() - 0.5) * 16.0;
+                    [p[0] + ahead * c - side * s, p[1] + ahead * s + side * c, r]
+                })
+                .filter(|&[x, y, r]| (x - p[0]).hypot(y - p[1]) > r + 0.01)
+                .collect();
+            let mut out = vec![f32::INFINITY; n];
+            overlay_circles(p, start, inc, &mut out, &circles);
+            for (k, &got) in out.iter().enumerate() {
+                let (dy, dx) = (start as f64 + k as f64 * inc as f64).sin_cos();
+                let mut want = f64::INFINITY;
+                let mut grazing = false;
+                for &[x, y, r] in &circles {
+                    let (vx, vy) = ((x - p[0]) as f64, (y - p[1]) as f64);
+                    let b = dx * vx + dy * vy;
+                    let disc = b * b - (vx * vx + vy * vy - (r * r) as f64);
+                    grazing |= disc.abs() < 1e-3;
+                    if disc >= 0.0 && b - disc.sqrt() >= 0.0 {
+                        want = want.min(b - disc.sqrt());
+                    }
+                }
+                assert!(
+                    grazing
+                        || (got.is_infinite() && want.is_infinite())
+                        || (got as f64 - want).abs() < 1e-3,
+                    "fov {fov}, beam {k}: {got} against {want}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn circles_and_segments_overlay_analytically() {
     // full 360° scan starting at -π; a circle behind the sensor (across the ±π wrap)

@@ -7,7 +7,8 @@ use crate::body::{Footprint, Person, PersonIndex, TruePose};
 use crate::core::RobotIndex;
 use bevy_ecs::prelude::*;
 
-/// Bucket side (m).
+/// Bucket side (m), unless the bodies are spread so far that a grid of such buckets over them
+/// would have many more buckets than bodies.
 const BUCKET: f64 = 4.0;
 
 /// Reusable output of [`RobotOutlines::near`].
@@ -24,8 +25,108 @@ pub struct RobotOutlines {
     circles: Vec<Option<[f32; 3]>>,
     polygons: Vec<Vec<[f32; 4]>>,
     centres: Vec<[f64; 3]>,
-    /// Bucket → robots in it (a fast non-cryptographic hash: a scan looks up ~100 buckets).
-    buckets: rustc_hash::FxHashMap<(i32, i32), Vec<u32>>,
+    buckets: Buckets,
+    /// The largest bounding radius of a body.
+    largest_radius: f64,
+    /// Scratch: every body's centre and slot, for bucketing.
+    placed: Vec<(f64, f64, u32)>,
+}
+
+/// The bodies bucketed on a grid of squares over their bounding box, by a counting sort: the
+/// slots in bucket b are `ids[start[b]..start[b + 1]]`, and a row's buckets are contiguous, so
+/// a laser's square of buckets is one slice per row (no hashing: a scan looks at ~30 buckets).
+#[derive(Default)]
+struct Buckets {
+    side: f64,
+    /// Bucket coordinates of the grid's first bucket, and the grid's size in buckets.
+    x0: i64,
+    y0: i64,
+    w: i64,
+    h: i64,
+    start: Vec<u32>,
+    ids: Vec<u32>,
+}
+
+impl Buckets {
+    fn coord(&self, v: f64) -> i64 {
+        // saturating: a NaN lands on 0, an infinity on the ends (then clamped into the grid)
+        (v / self.side).floor() as i64
+    }
+
+    /// The bucket of a point inside the grid (points outside are clamped to its edge).
+    fn bucket(&self, x: f64, y: f64) -> usize {
+        let bx = (self.coord(x) - self.x0).clamp(0, self.w - 1);
+        let by = (self.coord(y) - self.y0).clamp(0, self.h - 1);
+        (by * self.w + bx) as usize
+    }
+
+    fn rebuild(&mut self, placed: &[(f64, f64, u32)]) {
+        self.ids.clear();
+        self.start.clear();
+        if placed.is_empty() {
+            (self.w, self.h) = (0, 0);
+            return;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for &(x, y, _) in placed {
+            (lo[0], lo[1]) = (lo[0].min(x), lo[1].min(y));
+            (hi[0], hi[1]) = (hi[0].max(x), hi[1].max(y));
+        }
+        if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
+            (lo, hi) = ([0.0; 2], [0.0; 2]);
+        }
+        let most = (4 * placed.len()).max(4096) as f64;
+        self.side = BUCKET;
+        while ((hi[0] - lo[0]) / self.side + 2.0) * ((hi[1] - lo[1]) / self.side + 2.0) > most {
+            self.side *= 2.0;
+        }
+        (self.x0, self.y0) = (self.coord(lo[0]), self.coord(lo[1]));
+        self.w = self.coord(hi[0]) - self.x0 + 1;
+        self.h = self.coord(hi[1]) - self.y0 + 1;
+        let cells = (self.w * self.h) as usize;
+        self.start.resize(cells + 1, 0);
+        for &(x, y, _) in placed {
+            let b = self.bucket(x, y);
+            self.start[b + 1] += 1;
+        }
+        for b in 0..cells {
+            self.start[b + 1] += self.start[b];
+        }
+        self.ids.resize(placed.len(), 0);
+        // each bucket filled from its start in placing order, `start[b]` moving to its end...
+        for &(x, y, id) in placed {
+            let b = self.bucket(x, y);
+            self.ids[self.start[b] as usize] = id;
+            self.start[b] += 1;
+        }
+        // ...and back: bucket b now ends where b + 1 begins
+        for b in (1..=cells).rev() {
+            self.start[b] = self.start[b - 1];
+        }
+        self.start[0] = 0;
+    }
+
+    /// Appends the slots of the buckets that meet the square [x0, x1] × [y0, y1].
+    fn extend_near(&self, x0: f64, y0: f64, x1: f64, y1: f64, out: &mut Vec<u32>) {
+        if self.w == 0 {
+            return;
+        }
+        let bx0 = (self.coord(x0) - self.x0).max(0);
+        let bx1 = (self.coord(x1) - self.x0).min(self.w - 1);
+        let by0 = (self.coord(y0) - self.y0).max(0);
+        let by1 = (self.coord(y1) - self.y0).min(self.h - 1);
+        if bx0 > bx1 || by0 > by1 {
+            return;
+        }
+        for by in by0..=by1 {
+            let row = by * self.w;
+            let (a, b) = (
+                self.start[(row + bx0) as usize] as usize,
+                self.start[(row + bx1 + 1) as usize] as usize,
+            );
+            out.extend_from_slice(&self.ids[a..b]);
+        }
+    }
 }
 
 impl RobotOutlines {
@@ -40,31 +141,11 @@ impl RobotOutlines {
         circles.clear();
         segments.clear();
         scratch.clear();
-        let b0 = (
-            ((x - range) / BUCKET).floor() as i32,
-            ((y - range) / BUCKET).floor() as i32,
-        );
-        let b1 = (
-            ((x + range) / BUCKET).floor() as i32,
-            ((y + range) / BUCKET).floor() as i32,
-        );
-        let nb = ((b1.0 - b0.0 + 1) as i64) * ((b1.1 - b0.1 + 1) as i64);
-        if nb as usize > self.buckets.len() {
-            // huge range relative to the world: scan the occupied buckets instead
-            for (k, v) in &self.buckets {
-                if k.0 >= b0.0 && k.0 <= b1.0 && k.1 >= b0.1 && k.1 <= b1.1 {
-                    scratch.extend_from_slice(v);
-                }
-            }
-        } else {
-            for bx in b0.0..=b1.0 {
-                for by in b0.1..=b1.1 {
-                    if let Some(v) = self.buckets.get(&(bx, by)) {
-                        scratch.extend_from_slice(v);
-                    }
-                }
-            }
-        }
+        // a body counts by its bounding disc: its centre may lie up to the largest radius
+        // beyond the range
+        let reach = range + self.largest_radius;
+        self.buckets
+            .extend_near(x - reach, y - reach, x + reach, y + reach, scratch);
         scratch.sort_unstable();
         for &i in scratch.iter() {
             if i == except {
@@ -107,9 +188,7 @@ pub fn update_robot_outlines(
     o.polygons.resize_with(n, Vec::new);
     o.centres.clear();
     o.centres.resize(n, [f64::NAN; 3]);
-    for v in o.buckets.values_mut() {
-        v.clear();
-    }
+    o.placed.clear();
     for (idx, truth, footprint) in robots.iter() {
         let i = idx.0 as usize;
         let p = truth.pose;
@@ -129,18 +208,22 @@ pub fn update_robot_outlines(
                 }
             }
         }
-        let key = ((p.x / BUCKET).floor() as i32, (p.y / BUCKET).floor() as i32);
-        o.buckets.entry(key).or_default().push(idx.0);
+        o.placed.push((p.x, p.y, idx.0));
     }
     for (idx, truth, person) in people.iter() {
         let i = n_robots + idx.0 as usize;
         let p = truth.pose;
         o.centres[i] = [p.x, p.y, person.radius];
         o.circles[i] = Some([p.x as f32, p.y as f32, person.radius as f32]);
-        let key = ((p.x / BUCKET).floor() as i32, (p.y / BUCKET).floor() as i32);
-        o.buckets.entry(key).or_default().push(i as u32);
+        o.placed.push((p.x, p.y, i as u32));
     }
-    o.buckets.retain(|_, v| !v.is_empty());
+    o.buckets.rebuild(&o.placed);
+    o.largest_radius = o
+        .centres
+        .iter()
+        .map(|c| c[2])
+        .filter(|r| r.is_finite())
+        .fold(0.0, f64::max);
 }
 
 #[cfg(test)]
@@ -204,5 +287,69 @@ mod tests {
         outlines.near(0.0, 0.0, 10.0, 0, &mut near);
         assert_eq!(near.circles.len(), 2, "the person and robot 1");
         assert_eq!(near.circles[1], [3.0, 0.0, 0.25], "people after robots");
+    }
+
+    /// The bodies a laser is shown are exactly those whose bounding disc comes within its
+    /// range, in index order, however the bodies are spread (a crowd, a few far apart, one
+    /// alone), and wherever the laser is (inside, at the edge of or far outside the crowd).
+    #[test]
+    fn nearby_bodies_are_those_in_range_however_spread() {
+        let mut rng = stream_rng(7, "outlines", "placing");
+        let mut next = || rand::RngExt::random::<f64>(&mut rng);
+        for (count, spread) in [(1, 10.0), (300, 60.0), (50, 20_000.0), (200, 3.0)] {
+            let mut world = World::new();
+            world.init_resource::<RobotOutlines>();
+            let mut centres = Vec::new();
+            for i in 0..count {
+                let (x, y) = ((next() - 0.5) * spread, (next() - 0.3) * spread);
+                let footprint = if i % 3 == 0 {
+                    Footprint::Rectangle {
+                        length: 0.8,
+                        width: 0.5,
+                    }
+                } else {
+                    Footprint::Circle { radius: 0.3 }
+                };
+                centres.push((x, y, footprint.bounding_radius()));
+                world.spawn((
+                    RobotIndex(i),
+                    TruePose::at(Pose2::new(x, y, next())),
+                    footprint,
+                ));
+            }
+            let mut schedule = Schedule::default();
+            schedule.add_systems(update_robot_outlines);
+            schedule.run(&mut world);
+            let outlines = world.resource::<RobotOutlines>();
+            let mut near = NearbyRobots::default();
+            for q in 0..50 {
+                let (x, y) = ((next() - 0.5) * spread * 1.5, (next() - 0.5) * spread * 1.5);
+                let range = [9.0, 0.5, 30.0][q % 3];
+                outlines.near(x, y, range, 0, &mut near);
+                let want: Vec<u32> = (1..count)
+                    .filter(|&i| {
+                        let (cx, cy, r) = centres[i as usize];
+                        (cx - x).hypot(cy - y) <= range + r
+                    })
+                    .collect();
+                let seen = near.circles.len() + near.segments.len() / 4;
+                let want_shapes: usize =
+                    want.iter().map(|&i| 1 + 3 * ((i % 3 == 0) as usize)).sum();
+                assert_eq!(
+                    near.circles.len() + near.segments.len(),
+                    want_shapes,
+                    "{count} bodies over {spread} m, query {q}: {seen} seen, {want:?} in range"
+                );
+                let circles: Vec<[f32; 3]> = want
+                    .iter()
+                    .filter(|&&i| i % 3 != 0)
+                    .map(|&i| {
+                        let (cx, cy, _) = centres[i as usize];
+                        [cx as f32, cy as f32, 0.3]
+                    })
+                    .collect();
+                assert_eq!(near.circles, circles, "{count} over {spread} m, query {q}");
+            }
+        }
     }
 }
