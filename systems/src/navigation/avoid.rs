@@ -57,18 +57,15 @@ struct BeamSectors {
     /// The runs in sector order, when no sector is seen in two runs (a fan that does not cross
     /// 2π into its own start): then each run is one point of the list, written in order.
     by_sector: Option<Vec<u32>>,
-    /// Scratch: each beam's squared distance from the robot's centre in the current scan, and
-    /// its point.
+    /// Scratch: each beam's squared distance from the robot's centre in the current scan.
     d2: Vec<f32>,
-    px: Vec<f32>,
-    py: Vec<f32>,
 }
 
 /// The nearest beam of the run [start, end) without a branch on the readings (whether a beam is
 /// lost or nearer than the one before is a coin toss in a real scan): its squared distance
-/// (+Inf when the run saw nothing; on a tie the first beam) and its point.
+/// (+Inf when the run saw nothing) and its index (on a tie the first beam).
 #[inline(always)]
-fn nearest_in_run(d2: &[f32], px: &[f32], py: &[f32], start: u32, end: u32) -> (f32, f32, f32) {
+fn nearest_in_run(d2: &[f32], start: u32, end: u32) -> (f32, usize) {
     let (start, end) = (start as usize, end as usize);
     let (mut bd, mut bk) = (f32::INFINITY, start);
     for (k, &d) in d2[start..end].iter().enumerate() {
@@ -77,7 +74,7 @@ fn nearest_in_run(d2: &[f32], px: &[f32], py: &[f32], start: u32, end: u32) -> (
         bd = if nearer { d } else { bd };
         bk = if nearer { k } else { bk };
     }
-    (bd, px[bk], py[bk])
+    (bd, bk)
 }
 
 impl BeamSectors {
@@ -115,8 +112,6 @@ impl BeamSectors {
             .all(|w| self.runs[w[0] as usize].0 != self.runs[w[1] as usize].0);
         self.by_sector = distinct.then_some(order);
         self.d2 = vec![0.0; n];
-        self.px = vec![0.0; n];
-        self.py = vec![0.0; n];
     }
 }
 
@@ -163,24 +158,19 @@ impl SectorRanges {
             runs,
             by_sector,
             d2,
-            px,
-            py,
             ..
         } = table;
-        for (((((d, x), y), &r), &c), &s) in d2
-            .iter_mut()
-            .zip(px.iter_mut())
-            .zip(py.iter_mut())
-            .zip(&scan.ranges)
-            .zip(&*cos)
-            .zip(&*sin)
-        {
+        for (((d, &r), &c), &s) in d2.iter_mut().zip(&scan.ranges).zip(&*cos).zip(&*sin) {
             let r = reading(r);
-            (*x, *y) = (mx + c * r, my + s * r);
-            *d = *x * *x + *y * *y;
+            let (x, y) = (mx + c * r, my + s * r);
+            *d = x * x + y * y;
         }
-        let (d2, px, py) = (&d2[..], &px[..], &py[..]);
-        let nearest_of = |start: u32, end: u32| nearest_in_run(d2, px, py, start, end);
+        let (d2, cos, sin) = (&d2[..], &cos[..], &sin[..]);
+        let nearest_of = |start: u32, end: u32| {
+            let (bd, bk) = nearest_in_run(d2, start, end);
+            let r = reading(scan.ranges[bk]);
+            (bd, mx + cos[bk] * r, my + sin[bk] * r)
+        };
         let mut len = 0;
         if let Some(order) = by_sector {
             // one run per sector: the runs' points in sector order, each written at the end of
