@@ -150,8 +150,8 @@ impl SectorRanges {
                 r
             }
         };
-        // every beam's point and squared distance from the centre, as one vectorized pass; a
-        // lost beam (+Inf, NaN) gives +Inf or NaN, which never compares below anything
+        // every beam's squared distance from the centre, as one vectorized pass; a lost beam
+        // (+Inf, NaN) gives +Inf or NaN, which never compares below anything
         let BeamSectors {
             cos,
             sin,

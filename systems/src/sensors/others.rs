@@ -67,12 +67,16 @@ impl Buckets {
             (self.w, self.h) = (0, 0);
             return;
         }
+        // the box of the finite centres (a body at a non-finite place, which no range test
+        // accepts, is clamped to an edge bucket and cannot stretch the grid)
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for &(x, y, _) in placed {
-            (lo[0], lo[1]) = (lo[0].min(x), lo[1].min(y));
-            (hi[0], hi[1]) = (hi[0].max(x), hi[1].max(y));
+            if x.is_finite() && y.is_finite() {
+                (lo[0], lo[1]) = (lo[0].min(x), lo[1].min(y));
+                (hi[0], hi[1]) = (hi[0].max(x), hi[1].max(y));
+            }
         }
-        if !(lo[0].is_finite() && lo[1].is_finite() && hi[0].is_finite() && hi[1].is_finite()) {
+        if lo[0] > hi[0] {
             (lo, hi) = ([0.0; 2], [0.0; 2]);
         }
         let most = (4 * placed.len()).max(4096) as f64;
@@ -351,5 +355,29 @@ mod tests {
                 assert_eq!(near.circles, circles, "{count} over {spread} m, query {q}");
             }
         }
+    }
+
+    /// A body thrown to infinity (a numerical blow-up) is never near, and does not stretch the
+    /// bucket grid so that the others are lost.
+    #[test]
+    fn a_body_at_infinity_hides_no_other() {
+        let mut world = World::new();
+        world.init_resource::<RobotOutlines>();
+        for (i, x) in [(0, 0.0), (1, 3.0), (2, 250.0), (3, f64::INFINITY)] {
+            world.spawn((
+                RobotIndex(i),
+                TruePose::at(Pose2::new(x, 1.0, 0.0)),
+                Footprint::Circle { radius: 0.3 },
+            ));
+        }
+        let mut schedule = Schedule::default();
+        schedule.add_systems(update_robot_outlines);
+        schedule.run(&mut world);
+        let outlines = world.resource::<RobotOutlines>();
+        let mut near = NearbyRobots::default();
+        outlines.near(0.0, 0.0, 9.0, 0, &mut near);
+        assert_eq!(near.circles, vec![[3.0, 1.0, 0.3]]);
+        outlines.near(250.0, 0.0, 9.0, 0, &mut near);
+        assert_eq!(near.circles, vec![[250.0, 1.0, 0.3]]);
     }
 }
