@@ -29,6 +29,9 @@ pub struct SectorRanges {
     xs: [f32; PADDED],
     ys: [f32; PADDED],
     len: usize,
+    /// The last answers of [`Self::choose_heading_remembered`] and
+    /// [`Self::free_distance_remembered`], forgotten at every [`Self::update`].
+    memo: Memo,
 }
 
 impl Default for SectorRanges {
@@ -37,8 +40,18 @@ impl Default for SectorRanges {
             xs: [f32::NAN; PADDED],
             ys: [f32::NAN; PADDED],
             len: 0,
+            memo: Memo::default(),
         }
     }
+}
+
+/// One remembered question and answer of each kind, keyed by the arguments' bits.
+#[derive(Clone, Debug, Default)]
+struct Memo {
+    /// (wanted, half width, needed, max deviation) → (heading, free distance).
+    choice: Option<([u64; 4], (f64, f64))>,
+    /// (heading, half width) → free distance.
+    free: Option<([u64; 2], f64)>,
 }
 
 /// A scan's beams in the robot's base frame: each beam's direction, and the runs of beams that
@@ -141,6 +154,7 @@ impl SectorRanges {
     }
 
     fn reduce(&mut self, scan: &LaserScan, mount: &Pose2, table: &mut BeamSectors) {
+        self.memo = Memo::default();
         let (mx, my) = (mount.x as f32, mount.y as f32);
         // a reading below range_min (-Inf) means something very close: taken as range_min
         let reading = |r: f32| {
@@ -238,6 +252,40 @@ impl SectorRanges {
     pub fn free_distance(&self, heading: f64, half_width: f64) -> f64 {
         let (uy, ux) = heading.sin_cos();
         self.free_along(ux, uy, half_width as f32) as f64
+    }
+
+    /// [`Self::free_distance`], answered from memory when asked the same as last time since the
+    /// last [`Self::update`] (a behaviour asks the same between two scans while its wanted
+    /// heading stays put, e.g. a wandering robot; the answer is the same to the bit).
+    pub fn free_distance_remembered(&mut self, heading: f64, half_width: f64) -> f64 {
+        let key = [heading.to_bits(), half_width.to_bits()];
+        match self.memo.free {
+            Some((k, f)) if k == key => f,
+            _ => {
+                let f = self.free_distance(heading, half_width);
+                self.memo.free = Some((key, f));
+                f
+            }
+        }
+    }
+
+    /// [`Self::choose_heading`], answered from memory like [`Self::free_distance_remembered`].
+    pub fn choose_heading_remembered(
+        &mut self,
+        wanted: f64,
+        half_width: f64,
+        needed: f64,
+        max_dev: f64,
+    ) -> (f64, f64) {
+        let key = [wanted, half_width, needed, max_dev].map(f64::to_bits);
+        match self.memo.choice {
+            Some((k, answer)) if k == key => answer,
+            _ => {
+                let answer = self.choose_heading(wanted, half_width, needed, max_dev);
+                self.memo.choice = Some((key, answer));
+                answer
+            }
+        }
     }
 
     /// [`Self::free_distance`] along the unit vector (ux, uy).
@@ -397,6 +445,18 @@ mod tests {
         assert!(h.abs() > 2.0 && (f - most).abs() < 1e-4, "{h} {f} {most}");
     }
 
+    /// A scan of 180 beams over the half turn ahead, 8 m range.
+    fn half_turn_scan(ranges: Vec<f32>) -> LaserScan {
+        LaserScan {
+            stamp: 0.0,
+            angle_min: -PI as f32 / 2.0,
+            angle_increment: (PI / 179.0) as f32,
+            range_min: 0.05,
+            range_max: 8.0,
+            ranges,
+        }
+    }
+
     /// The choice as its doc reads: every candidate's free distance over all the points.
     fn choose_by_definition(
         s: &SectorRanges,
@@ -430,14 +490,7 @@ mod tests {
                     _ => (0.2 + next() * 4.0) as f32,
                 })
                 .collect();
-            let scan = LaserScan {
-                stamp: 0.0,
-                angle_min: -PI as f32 / 2.0,
-                angle_increment: (PI / 179.0) as f32,
-                range_min: 0.05,
-                range_max: 8.0,
-                ranges,
-            };
+            let scan = half_turn_scan(ranges);
             let s = SectorRanges::from_scan(&scan, &Pose2::new(0.1, 0.0, 0.0));
             let wanted = (next() - 0.5) * 2.0;
             let needed = 0.5 + next() * 5.0;
@@ -456,6 +509,44 @@ mod tests {
             differing_paths > 10 && differing_paths < 390,
             "{differing_paths}"
         );
+    }
+
+    /// The remembered answers are the answers: asked again with the same arguments they repeat
+    /// them, asked anything else or after a new scan they are computed afresh.
+    #[test]
+    fn remembered_answers_are_forgotten_at_every_scan() {
+        let mut rng = crate::core::stream_rng(11, "avoid", "memo");
+        let mut next = || rand::RngExt::random::<f64>(&mut rng);
+        let mut s = SectorRanges::default();
+        let mut changed = 0;
+        let mut previous = None;
+        for case in 0..200 {
+            let ranges = (0..180)
+                .map(|_| (0.2 + next() * 4.0) as f32)
+                .collect::<Vec<_>>();
+            let scan = half_turn_scan(ranges);
+            s.update(&scan, &Pose2::IDENTITY);
+            // the same question as before the new scan, then a few others
+            let mut questions = vec![(0.1, 0.3, 2.0)];
+            for _ in 0..3 {
+                questions.push(((next() - 0.5) * 2.0, 0.2 + next() * 0.3, 0.5 + next() * 5.0));
+            }
+            for (wanted, hw, needed) in questions {
+                for _ in 0..2 {
+                    let fresh = SectorRanges::from_scan(&scan, &Pose2::IDENTITY);
+                    let want = fresh.choose_heading(wanted, hw, needed, PI * 0.8);
+                    let got = s.choose_heading_remembered(wanted, hw, needed, PI * 0.8);
+                    assert_eq!(got, want, "case {case}");
+                    let got = s.free_distance_remembered(wanted, hw);
+                    assert_eq!(got, fresh.free_distance(wanted, hw), "case {case}");
+                }
+            }
+            let answer = s.choose_heading_remembered(0.1, 0.3, 2.0, PI * 0.8);
+            changed += usize::from(previous.is_some_and(|p| p != answer));
+            previous = Some(answer);
+        }
+        // the scans differ enough that the first question's answer changes with them
+        assert!(changed > 50, "{changed}");
     }
 
     /// The reduction beam by beam into the sectors' slots, as the definition reads.

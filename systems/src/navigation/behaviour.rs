@@ -132,10 +132,12 @@ impl Behaviour {
         // near a goal, only the way to the goal needs to be free (a waypoint just inside a
         // furnished room must not send the robot looking for 1.8 m of open floor)
         let needed = lookahead.min(goal_distance + 0.2);
-        let (heading, free, ahead) = match &self.sectors {
+        // between two scans the sectors do not change, so a wanted heading that stays put (a
+        // wandering robot's) gets its answers from memory
+        let (heading, free, ahead) = match &mut self.sectors {
             Some(s) => {
-                let (h, f) = s.choose_heading(wanted, self.half_width, needed, PI * 0.8);
-                (h, f, s.free_distance(0.0, self.half_width))
+                let (h, f) = s.choose_heading_remembered(wanted, self.half_width, needed, PI * 0.8);
+                (h, f, s.free_distance_remembered(0.0, self.half_width))
             }
             None => (wanted, f64::INFINITY, f64::INFINITY),
         };
