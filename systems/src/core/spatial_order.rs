@@ -3,6 +3,8 @@
 //! tiles, which then come from the core's cache instead of memory. Only the visiting order
 //! changes, never a result (every job writes its own outputs).
 
+use bevy_ecs::prelude::Entity;
+
 /// Side of the square cells the key orders (m): about one tile of the scan sweep (64 cells of
 /// 5 cm), so the robots of one cell share their nearest tiles.
 pub const CELL: f64 = 3.2;
@@ -27,9 +29,110 @@ fn spread(mut v: u64) -> u64 {
     (v | (v << 1)) & 0x5555_5555_5555_5555
 }
 
+/// A Morton visiting order kept from call to call. Robots move a few centimetres a tick, so the
+/// order is sorted again only every [`SpatialOrder::REFRESH_CALLS`] calls, or at once when the
+/// items are other entities than last time; in between, reading every robot's pose on the
+/// calling thread (just written by the workers, so a cache miss each) to sort them cost more
+/// than the order saved.
+#[derive(Default)]
+pub struct SpatialOrder {
+    /// The items' entities, in the order they came in at the last sort.
+    entities: Vec<Entity>,
+    /// Each of those items' place in the visiting order.
+    rank: Vec<u32>,
+    /// Calls since the last sort.
+    age: u32,
+}
+
+impl SpatialOrder {
+    pub const REFRESH_CALLS: u32 = 20;
+
+    /// `items` in the Morton order of the positions they had at the last sort (each item's
+    /// entity by `entity`, its position by `position`).
+    pub fn arrange<T>(
+        &mut self,
+        items: Vec<T>,
+        entity: impl Fn(&T) -> Entity,
+        position: impl Fn(&T) -> (f64, f64),
+    ) -> Vec<T> {
+        let n = items.len();
+        let same = self.entities.len() == n
+            && items
+                .iter()
+                .zip(&self.entities)
+                .all(|(t, &e)| entity(t) == e);
+        if !same || self.age >= Self::REFRESH_CALLS {
+            let mut keyed: Vec<(u64, u32)> = items
+                .iter()
+                .enumerate()
+                .map(|(i, t)| {
+                    let (x, y) = position(t);
+                    (morton_key(x, y), i as u32)
+                })
+                .collect();
+            keyed.sort_unstable();
+            self.rank.resize(n, 0);
+            for (r, &(_, i)) in keyed.iter().enumerate() {
+                self.rank[i as usize] = r as u32;
+            }
+            self.entities = items.iter().map(&entity).collect();
+            self.age = 0;
+        }
+        self.age += 1;
+        let mut slots: Vec<Option<T>> = (0..n).map(|_| None).collect();
+        for (t, &r) in items.into_iter().zip(&self.rank) {
+            slots[r as usize] = Some(t);
+        }
+        slots.into_iter().flatten().collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bevy_ecs::prelude::World;
+
+    /// The order is the Morton order at the last sort: kept while the robots move, sorted
+    /// again after [`SpatialOrder::REFRESH_CALLS`] calls, and at once for other entities.
+    #[test]
+    fn the_order_is_kept_a_while_and_follows_other_entities_at_once() {
+        let mut world = World::new();
+        let entities: Vec<Entity> = (0..50).map(|_| world.spawn_empty().id()).collect();
+        let mut places: Vec<(f64, f64)> = (0..50)
+            .map(|i| (((i * 37) % 50) as f64 * 2.9, ((i * 11) % 50) as f64 * 1.7))
+            .collect();
+        let sorted = |items: &[(Entity, (f64, f64))]| {
+            let mut v = items.to_vec();
+            v.sort_by_key(|&(e, (x, y))| (morton_key(x, y), e.index()));
+            v.iter().map(|x| x.0).collect::<Vec<_>>()
+        };
+        let items = |places: &[(f64, f64)]| -> Vec<(Entity, (f64, f64))> {
+            entities
+                .iter()
+                .copied()
+                .zip(places.iter().copied())
+                .collect()
+        };
+        let mut order = SpatialOrder::default();
+        let arrange = |order: &mut SpatialOrder, items: Vec<(Entity, (f64, f64))>| {
+            let got = order.arrange(items, |t| t.0, |t| t.1);
+            got.iter().map(|t| t.0).collect::<Vec<_>>()
+        };
+        let first = arrange(&mut order, items(&places));
+        assert_eq!(first, sorted(&items(&places)));
+        // everyone moves far: the old order stands until the refresh
+        places.reverse();
+        for call in 1..SpatialOrder::REFRESH_CALLS {
+            assert_eq!(arrange(&mut order, items(&places)), first, "call {call}");
+        }
+        let refreshed = arrange(&mut order, items(&places));
+        assert_eq!(refreshed, sorted(&items(&places)));
+        assert_ne!(refreshed, first);
+        // one entity fewer: sorted at once, and nothing is lost
+        let fewer: Vec<_> = items(&places).into_iter().skip(1).collect();
+        let got = arrange(&mut order, fewer.clone());
+        assert_eq!(got, sorted(&fewer));
+    }
 
     #[test]
     fn a_cell_shares_one_key_and_its_quadrants_follow_z_order() {
