@@ -79,11 +79,16 @@ impl SpatialOrder {
             self.age = 0;
         }
         self.age += 1;
-        let mut slots: Vec<Option<T>> = (0..n).map(|_| None).collect();
-        for (t, &r) in items.into_iter().zip(&self.rank) {
-            slots[r as usize] = Some(t);
+        // in place: the item at i goes to place[i], and whatever was there comes to i
+        let (mut items, mut place) = (items, self.rank.clone());
+        for i in 0..n {
+            while place[i] as usize != i {
+                let j = place[i] as usize;
+                items.swap(i, j);
+                place.swap(i, j);
+            }
         }
-        slots.into_iter().flatten().collect()
+        items
     }
 }
 
