@@ -16,6 +16,26 @@ pub(crate) fn wrap_tau(mut a: f32) -> f32 {
     a
 }
 
+/// atan2 by a minimax polynomial (max error about 1e-5 rad), without branches so that loops
+/// over faces vectorise: intervals are taken with a [`MARGIN`] and every hit is then computed
+/// exactly, so the approximation never changes a range. atan2(0, 0) = 0.
+#[inline]
+pub(crate) fn atan2_approx(y: f32, x: f32) -> f32 {
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let (ax, ay) = (x.abs(), y.abs());
+    let (mn, mx) = (ax.min(ay), ax.max(ay));
+    let a = mn / mx.max(f32::MIN_POSITIVE);
+    let s = a * a;
+    let mut r =
+        a * (0.999_866 + s * (-0.330_299_5 + s * (0.180_141 + s * (-0.085_133 + s * 0.020_835_1))));
+    r = if ay > ax { FRAC_PI_2 - r } else { r };
+    r = if x < 0.0 { PI - r } else { r };
+    if y < 0.0 { -r } else { r }
+}
+
+/// Margin of an angular interval found with [`atan2_approx`] (radians): wider than its error.
+pub(crate) const MARGIN: f32 = 1e-4;
+
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Fan {
     start: f32,

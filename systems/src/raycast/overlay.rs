@@ -2,8 +2,11 @@
 //! beam-index interval it subtends from the sensor, and only those beams are intersected, so the
 //! cost is proportional to the beams actually covered. Beam directions inside an interval are
 //! rotated on from its first beam (two multiply-adds per beam instead of a sine and a cosine).
+//! The intervals come from the polynomial arctangent of the face sweep, widened by its margin:
+//! every beam in them is then intersected exactly, so a beam the interval takes in needlessly
+//! only costs its test.
 
-use super::fan::Fan;
+use super::fan::{Fan, MARGIN, atan2_approx};
 use std::f32::consts::{PI, TAU};
 
 /// A scan's beams with the rotation by one increment, taken once per overlay call.
@@ -76,10 +79,10 @@ pub fn overlay_circles(
         {
             continue;
         }
-        let d = d2.sqrt();
-        let half = (r / d).asin();
-        let centre = vy.atan2(vx);
         let c = d2 - r * r;
+        // asin(r / d), the half-angle the circle subtends
+        let half = atan2_approx(r, c.sqrt()) + MARGIN;
+        let centre = atan2_approx(vy, vx);
         beams.for_each(centre - half, 2.0 * half, |k, sx, sy| {
             let b = sx * vx + sy * vy;
             let disc = b * b - c;
@@ -105,8 +108,8 @@ pub fn overlay_segments(
     for &[x0, y0, x1, y1] in segments {
         let (ax, ay) = (x0 - p[0], y0 - p[1]);
         let (bx, by) = (x1 - p[0], y1 - p[1]);
-        let a0 = ay.atan2(ax);
-        let a1 = by.atan2(bx);
+        let a0 = atan2_approx(ay, ax);
+        let a1 = atan2_approx(by, bx);
         let mut diff = a1 - a0;
         if diff > PI {
             diff -= TAU;
@@ -115,7 +118,7 @@ pub fn overlay_segments(
         }
         let (lo, width) = if diff >= 0.0 { (a0, diff) } else { (a1, -diff) };
         let (ex, ey) = (bx - ax, by - ay);
-        beams.for_each(lo - 1e-6, width + 2e-6, |k, sx, sy| {
+        beams.for_each(lo - MARGIN, width + 2.0 * MARGIN, |k, sx, sy| {
             // solve t·s = a + u·e for t ≥ 0, u ∈ [0, 1]
             let den = sx * ey - sy * ex;
             if den.abs() < 1e-12 {

@@ -10,7 +10,7 @@
 //! of [`super::cast_dda`]. Cost grows with the faces actually visible, not with the length of the
 //! rays.
 
-use super::fan::Fan;
+use super::fan::{Fan, MARGIN, atan2_approx};
 use std::f32::consts::TAU;
 
 /// Cells per side of a tile. Faces are merged along straight runs within a tile, and a tile is
@@ -20,23 +20,6 @@ use std::f32::consts::TAU;
 pub(crate) const TILE: usize = 64;
 /// Offsets are tabulated to this many tiles (64 × 64 cells, 205 m at 5 cm).
 const RADIUS: i32 = 64;
-
-/// atan2 by a minimax polynomial (max error about 1e-5 rad), without branches so that loops
-/// over faces vectorise: intervals are taken with a [`MARGIN`] and every hit is then computed
-/// exactly, so the approximation never changes a range. atan2(0, 0) = 0.
-#[inline]
-fn atan2_approx(y: f32, x: f32) -> f32 {
-    use std::f32::consts::{FRAC_PI_2, PI};
-    let (ax, ay) = (x.abs(), y.abs());
-    let (mn, mx) = (ax.min(ay), ax.max(ay));
-    let a = mn / mx.max(f32::MIN_POSITIVE);
-    let s = a * a;
-    let mut r =
-        a * (0.999_866 + s * (-0.330_299_5 + s * (0.180_141 + s * (-0.085_133 + s * 0.020_835_1))));
-    r = if ay > ax { FRAC_PI_2 - r } else { r };
-    r = if x < 0.0 { PI - r } else { r };
-    if y < 0.0 { -r } else { r }
-}
 
 /// Beam k's direction (dx, dy) and the reciprocals (1/dx, 1/dy) into `dirs[k]`, for beams at
 /// `start + k·inc`: four interleaved rotation recurrences (by 4·inc, so they do not wait on each
@@ -81,9 +64,6 @@ fn beam_dirs(start: f32, inc: f32, dirs: &mut [[f32; 4]]) {
         }
     }
 }
-
-/// Margin of a face's angular interval (radians): wider than the error of [`atan2_approx`].
-const MARGIN: f32 = 1e-4;
 
 /// Beams per block of the occlusion maxima.
 const BLOCK: usize = 16;

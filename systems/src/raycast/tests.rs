@@ -313,6 +313,56 @@ fn half_turn_fans_see_every_circle_in_front() {
     }
 }
 
+/// Every beam that crosses a segment reads its distance, whatever the fan and wherever the
+/// segment: the beam intervals come from an approximate arctangent, so none may fall short.
+#[test]
+fn fans_see_every_segment_they_cross() {
+    let mut rng = crate::core::stream_rng(7, "overlay", "segments");
+    let mut next = || rand::RngExt::random::<f32>(&mut rng);
+    for (n, fov) in [(181usize, PI), (1081, 1.5 * PI), (360, 2.0 * PI - 0.01)] {
+        let inc = fov / (n - 1) as f32;
+        for _ in 0..100 {
+            let start = next() * 2.0 * PI - PI;
+            let p = [next() * 4.0 - 2.0, next() * 4.0 - 2.0];
+            let segments: Vec<[f32; 4]> = (0..8)
+                .map(|_| {
+                    let (x, y) = (p[0] + (next() - 0.5) * 12.0, p[1] + (next() - 0.5) * 12.0);
+                    let (a, l) = (next() * 2.0 * PI, 0.05 + next() * 1.5);
+                    [x, y, x + l * a.cos(), y + l * a.sin()]
+                })
+                .collect();
+            let mut out = vec![f32::INFINITY; n];
+            overlay_segments(p, start, inc, &mut out, &segments);
+            for (k, &got) in out.iter().enumerate() {
+                let (dy, dx) = (start as f64 + k as f64 * inc as f64).sin_cos();
+                let mut want = f64::INFINITY;
+                let mut grazing = false;
+                for &[x0, y0, x1, y1] in &segments {
+                    let (ax, ay) = ((x0 - p[0]) as f64, (y0 - p[1]) as f64);
+                    let (ex, ey) = ((x1 - x0) as f64, (y1 - y0) as f64);
+                    let den = dx * ey - dy * ex;
+                    if den.abs() < 1e-9 {
+                        grazing = true;
+                        continue;
+                    }
+                    let t = (ax * ey - ay * ex) / den;
+                    let u = (ax * dy - ay * dx) / den;
+                    grazing |= t >= 0.0 && (u.abs() < 1e-3 || (u - 1.0).abs() < 1e-3);
+                    if t >= 0.0 && (0.0..=1.0).contains(&u) {
+                        want = want.min(t);
+                    }
+                }
+                assert!(
+                    grazing
+                        || (got.is_infinite() && want.is_infinite())
+                        || (got as f64 - want).abs() < 1e-3,
+                    "fov {fov}, beam {k}: {got} against {want}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn circles_and_segments_overlay_analytically() {
     // full 360° scan starting at -π; a circle behind the sensor (across the ±π wrap)
