@@ -1,6 +1,7 @@
 //! A scan's beams as a fan of angles `start + k·inc`, k < n: which beam indices an arc of
 //! directions covers. Shared by the face sweep and the moving-obstacle overlays; the reciprocal of
-//! the increment is taken once per scan, so mapping an arc costs two multiplications.
+//! the increment is taken once per scan, so mapping an arc costs two multiplications. The arcs
+//! themselves come from [`atan2_approx`], widened by its [`MARGIN`].
 
 use std::f32::consts::TAU;
 
