@@ -263,6 +263,22 @@ fn edge_cases() {
     assert!((rm.cast([5.0, 5.0], 0.0, 4.95) - 4.9).abs() < 1e-4);
 }
 
+/// Every beam of the fan `start + k·inc` reads, within 1 mm, the distance `exact(dx, dy)` gives
+/// for its direction (in f64; +Inf for a miss), unless `exact` calls the beam grazing.
+fn assert_beams_agree(out: &[f32], start: f32, inc: f32, exact: impl Fn(f64, f64) -> (f64, bool)) {
+    for (k, &got) in out.iter().enumerate() {
+        let (dy, dx) = (start as f64 + k as f64 * inc as f64).sin_cos();
+        let (want, grazing) = exact(dx, dy);
+        assert!(
+            grazing
+                || (got.is_infinite() && want.is_infinite())
+                || (got as f64 - want).abs() < 1e-3,
+            "{} beams from {start} by {inc}, beam {k}: {got} against {want}",
+            out.len()
+        );
+    }
+}
+
 /// Fans of up to half a turn skip circles wholly behind the sensor without missing one: every
 /// beam agrees with the analytic distance to the nearest circle, also for circles just behind,
 /// on or just in front of the line across the fan's central direction.
@@ -289,8 +305,7 @@ fn half_turn_fans_see_every_circle_in_front() {
                 .collect();
             let mut out = vec![f32::INFINITY; n];
             overlay_circles(p, start, inc, &mut out, &circles);
-            for (k, &got) in out.iter().enumerate() {
-                let (dy, dx) = (start as f64 + k as f64 * inc as f64).sin_cos();
+            assert_beams_agree(&out, start, inc, |dx, dy| {
                 let mut want = f64::INFINITY;
                 let mut grazing = false;
                 for &[x, y, r] in &circles {
@@ -302,13 +317,8 @@ fn half_turn_fans_see_every_circle_in_front() {
                         want = want.min(b - disc.sqrt());
                     }
                 }
-                assert!(
-                    grazing
-                        || (got.is_infinite() && want.is_infinite())
-                        || (got as f64 - want).abs() < 1e-3,
-                    "fov {fov}, beam {k}: {got} against {want}"
-                );
-            }
+                (want, grazing)
+            });
         }
     }
 }
@@ -333,8 +343,7 @@ fn fans_see_every_segment_they_cross() {
                 .collect();
             let mut out = vec![f32::INFINITY; n];
             overlay_segments(p, start, inc, &mut out, &segments);
-            for (k, &got) in out.iter().enumerate() {
-                let (dy, dx) = (start as f64 + k as f64 * inc as f64).sin_cos();
+            assert_beams_agree(&out, start, inc, |dx, dy| {
                 let mut want = f64::INFINITY;
                 let mut grazing = false;
                 for &[x0, y0, x1, y1] in &segments {
@@ -352,13 +361,8 @@ fn fans_see_every_segment_they_cross() {
                         want = want.min(t);
                     }
                 }
-                assert!(
-                    grazing
-                        || (got.is_infinite() && want.is_infinite())
-                        || (got as f64 - want).abs() < 1e-3,
-                    "fov {fov}, beam {k}: {got} against {want}"
-                );
-            }
+                (want, grazing)
+            });
         }
     }
 }
