@@ -46,12 +46,7 @@ pub struct BatchBenchRow {
 }
 
 pub fn run_batch_bench(o: &BenchBatchArgs) -> anyhow::Result<BatchBenchRow> {
-    if !(o.duration.is_finite() && o.duration > 0.0) {
-        anyhow::bail!(
-            "--duration: expected a positive number of seconds, got {}",
-            o.duration
-        );
-    }
+    crate::run_cmd::check_duration(o.duration)?;
     if o.seeds == 0 || o.reps == 0 {
         anyhow::bail!("--seeds and --reps: expected at least 1");
     }

@@ -46,10 +46,7 @@ pub struct SlamBenchRow {
 pub fn run_slam_bench(o: &SlamBenchOptions) -> anyhow::Result<Vec<SlamBenchRow>> {
     let mut scenario = bundled("hospital_loop")?;
     if let Some(d) = o.duration {
-        if !(d.is_finite() && d > 0.0) {
-            anyhow::bail!("--duration: expected a positive number of seconds, got {d}");
-        }
-        scenario.duration = scenario.duration.min(d);
+        scenario.duration = scenario.duration.min(crate::run_cmd::check_duration(d)?);
     }
     // every mode resolves before the (long) simulation
     let home = systems::core::Pose2::default();

@@ -148,7 +148,7 @@ enum BenchCommand {
         #[arg(long)]
         json: bool,
         /// Scenarios: bundled names or paths.
-        #[arg(long = "scenario", value_delimiter = ',', default_values_t = sim::bench_record::SCENARIOS.map(String::from))]
+        #[arg(long = "scenario", value_delimiter = ',', num_args = 1.., default_values_t = sim::bench_record::SCENARIOS.map(String::from))]
         scenarios: Vec<String>,
         /// Runs per mode (the median is reported).
         #[arg(long, default_value_t = 3)]
@@ -169,13 +169,13 @@ enum BenchCommand {
         #[arg(long)]
         json: bool,
         /// Populations to run.
-        #[arg(long, value_delimiter = ',', default_values_t = [1usize, 10, 100, 1000])]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = [1usize, 10, 100, 1000])]
         robots: Vec<usize>,
         /// Beams per scan.
-        #[arg(long, value_delimiter = ',', default_values_t = [180usize, 1081])]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = [180usize, 1081])]
         beams: Vec<usize>,
         /// Simulated seconds per configuration.
-        #[arg(long, default_value_t = 10.0)]
+        #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
         duration: f64,
         /// Worker threads (0 = one per core).
         #[arg(long, default_value_t = 0)]
@@ -187,7 +187,7 @@ enum BenchCommand {
         #[arg(long)]
         json: bool,
         /// SLAM modes to time.
-        #[arg(long, value_delimiter = ',', default_values_t = ["scan_to_map", "graph", "rbpf"].map(String::from))]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = ["scan_to_map", "graph", "rbpf"].map(String::from))]
         modes: Vec<String>,
         /// Kernel threads the SLAM runs on (the targets are for one core).
         #[arg(long, default_value_t = 1)]
@@ -214,7 +214,7 @@ enum BenchCommand {
         #[arg(long, default_value_t = 50)]
         reps: usize,
         /// Particle counts.
-        #[arg(long, value_delimiter = ',', default_values_t = [1000usize, 5000, 20000])]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = [1000usize, 5000, 20000])]
         particles: Vec<usize>,
         /// Beams used per scan.
         #[arg(long, default_value_t = 60)]
@@ -251,7 +251,7 @@ enum ExperimentCommand {
         #[arg(long)]
         per_run: bool,
         /// Routes (bundled scenario names or paths).
-        #[arg(long, value_delimiter = ',', default_values_t = sim::experiment::park::ROUTES.map(String::from))]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = sim::experiment::park::ROUTES.map(String::from))]
         routes: Vec<String>,
         /// Worker threads (0 = one per core). Results do not depend on it.
         #[arg(long, default_value_t = 0)]
@@ -299,10 +299,10 @@ enum ExperimentCommand {
         #[arg(long)]
         json: bool,
         /// Scenarios: bundled names or paths.
-        #[arg(long, value_delimiter = ',', default_values_t = SLAM_SCENARIOS.map(String::from))]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = SLAM_SCENARIOS.map(String::from))]
         scenarios: Vec<String>,
         /// Methods to run.
-        #[arg(long, value_delimiter = ',', default_values_t = SLAM_METHODS.map(String::from))]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = SLAM_METHODS.map(String::from))]
         methods: Vec<String>,
         /// Kernel threads (0 = one per core). Results do not depend on it.
         #[arg(long, default_value_t = 0)]

@@ -68,10 +68,14 @@ pub(super) fn resolve_laser(c: &Checker, p: &KeyPath, l: &LaserFile) -> R<LaserS
             .range(&p.key("increment_deg"), v, Some(0.0), Some(90.0), true)?
             .to_radians();
     }
-    if s.beams() > 20_000 {
+    if s.beams() > LaserSpec::MAX_BEAMS {
         return c.err(
             &p.key("increment_deg"),
-            format!("{} beams per scan is more than 20000", s.beams()),
+            format!(
+                "{} beams per scan is more than {}",
+                s.beams(),
+                LaserSpec::MAX_BEAMS
+            ),
         );
     }
     RangeKeys {

@@ -292,6 +292,83 @@ fn bench_mcl_prints_json_lines() {
     assert!(rows.iter().all(|r| r["beams"] == 60), "{rows:?}");
 }
 
+/// Lists take commas or spaces, and each row reports the population and laser asked for.
+#[test]
+fn bench_swarm_prints_one_row_per_population_and_laser() {
+    let fields = [
+        "robots",
+        "beams",
+        "real_time_factor",
+        "rays_per_s",
+        "sim_time_s",
+    ];
+    let spaced = bench_rows(
+        &[
+            "bench",
+            "swarm",
+            "--json",
+            "--robots",
+            "1",
+            "3",
+            "--beams",
+            "30",
+            "--duration",
+            "0.3",
+        ],
+        &fields,
+    );
+    let commas = bench_rows(
+        &[
+            "bench",
+            "swarm",
+            "--json",
+            "--robots",
+            "1,3",
+            "--beams",
+            "30,45",
+            "--duration",
+            "0.3",
+        ],
+        &fields,
+    );
+    let asked = |rows: &[serde_json::Value]| -> Vec<(u64, u64)> {
+        rows.iter()
+            .map(|r| (r["robots"].as_u64().unwrap(), r["beams"].as_u64().unwrap()))
+            .collect()
+    };
+    assert_eq!(asked(&spaced), [(1, 30), (3, 30)]);
+    assert_eq!(asked(&commas), [(1, 30), (3, 30), (1, 45), (3, 45)]);
+    let ran = |r: &serde_json::Value| (r["sim_time_s"].as_f64().unwrap() - 0.3).abs() < 1e-9;
+    assert!(commas.iter().all(ran), "{commas:?}");
+}
+
+/// Options the swarm benchmark cannot honour are refused before anything runs, naming the
+/// option, instead of being clamped or running forever.
+#[test]
+fn bench_swarm_refuses_bad_options() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, expected) in [
+        (
+            &["--duration", "-5"][..],
+            &["--duration", "positive", "-5"][..],
+        ),
+        (&["--duration=0"], &["--duration", "positive"]),
+        (&["--duration", "nan"], &["--duration", "positive"]),
+        (&["--duration", "inf"], &["--duration", "positive"]),
+        (&["--beams", "1"], &["--beams", "2 to 20000", "got 1"]),
+        (&["--beams", "180,20001"], &["--beams", "got 20001"]),
+        (&["--robots", "10,0"], &["--robots", "at least 1", "got 0"]),
+        (
+            &["--robots", "1000000"],
+            &["--robots 1000000", "free floor"],
+        ),
+    ] {
+        let mut all = vec!["bench", "swarm", "--json"];
+        all.extend_from_slice(args);
+        expect_failure(&all, dir.path(), expected);
+    }
+}
+
 #[test]
 fn bench_markov_grid_prints_json_lines() {
     let rows = bench_rows(

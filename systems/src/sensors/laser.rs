@@ -74,6 +74,10 @@ impl LaserSpec {
 
     pub const PRESETS: [&'static str; 2] = ["sick_lms100", "hokuyo_urg04lx"];
 
+    /// The most beams a scan may have (a 360° laser at 0.018°); scenarios and benchmarks
+    /// refuse more.
+    pub const MAX_BEAMS: usize = 20_000;
+
     /// Number of beams: fov / increment + 1 (both ends included).
     pub fn beams(&self) -> usize {
         (self.fov / self.increment + 1e-6).floor() as usize + 1
