@@ -51,16 +51,21 @@ pub fn robot_file(out: &Path, robot: &str, count: usize) -> PathBuf {
     out.with_file_name(name)
 }
 
+/// The robots of `scenario` that can be exported (a laser and wheel encoders): index and name.
+pub fn exported_robots(scenario: &Scenario) -> Vec<(u32, &str)> {
+    scenario
+        .robots
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| r.laser.is_some() && r.encoder.is_some())
+        .map(|(i, r)| (i as u32, r.name.as_str()))
+        .collect()
+}
+
 impl CarmenExport {
     /// The logs of `scenario`'s robots with a laser and encoders (an error if there is none).
     pub fn new(scenario: &Scenario, out: &Path) -> anyhow::Result<Self> {
-        let chosen: Vec<(u32, &str)> = scenario
-            .robots
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| r.laser.is_some() && r.encoder.is_some())
-            .map(|(i, r)| (i as u32, r.name.as_str()))
-            .collect();
+        let chosen = exported_robots(scenario);
         if chosen.is_empty() {
             anyhow::bail!(
                 "--carmen-out: {} has no robot with a laser and wheel encoders to export",

@@ -13,7 +13,7 @@ use sim::experiment::slam_compare::{
 };
 use sim::interrupt::Interrupted;
 use sim::match_cmd::{CrossoverArg, FitnessArg, MatchOptions, parse_strategy, run_match};
-use sim::run_cmd::{RunArgs, check_duration, run_command, scenario_arg};
+use sim::run_cmd::{RunArgs, check_duration, parse_threads, run_command, scenario_arg};
 use sim::runner::ScanCapture;
 use sim::scenario::{bundled_scenarios, load_scenario};
 use sim::slam_cmd::{SlamArgs, run_slam_command};
@@ -68,8 +68,9 @@ enum Command {
         /// Override the scenario's seed.
         #[arg(long)]
         seed: Option<u64>,
-        /// Worker threads for parallel kernels (0 = one per core). Results do not depend on it.
-        #[arg(long, default_value_t = 0)]
+        /// Worker threads for parallel kernels (0 = one per core; at most 1024). Results do not
+        /// depend on it.
+        #[arg(long, default_value_t = 0, value_parser = parse_threads)]
         threads: usize,
         /// No progress bar and no report, only errors.
         #[arg(long)]
@@ -157,8 +158,8 @@ enum BenchCommand {
         /// duration otherwise).
         #[arg(long, allow_negative_numbers = true)]
         duration: Option<f64>,
-        /// Kernel threads (0 = one per core).
-        #[arg(long, default_value_t = 0)]
+        /// Kernel threads (0 = one per core; at most 1024).
+        #[arg(long, default_value_t = 0, value_parser = parse_threads)]
         threads: usize,
     },
     /// Wall time of a batch with --jobs 1 --threads 1 and with --jobs 2, and the speed-up.
@@ -177,8 +178,8 @@ enum BenchCommand {
         /// Simulated seconds per configuration.
         #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
         duration: f64,
-        /// Worker threads (0 = one per core).
-        #[arg(long, default_value_t = 0)]
+        /// Worker threads (0 = one per core; at most 1024).
+        #[arg(long, default_value_t = 0, value_parser = parse_threads)]
         threads: usize,
     },
     /// Real-time factor and time per scan of each SLAM mode on the hospital loop run.
@@ -187,12 +188,13 @@ enum BenchCommand {
         #[arg(long)]
         json: bool,
         /// SLAM modes to time.
-        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = ["scan_to_map", "graph", "rbpf"].map(String::from))]
+        #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = sim::bench_slam::MODES.map(String::from))]
         modes: Vec<String>,
-        /// Kernel threads the SLAM runs on (the targets are for one core).
-        #[arg(long, default_value_t = 1)]
+        /// Kernel threads the SLAM runs on (0 = one per core; at most 1024; the targets are for
+        /// one core).
+        #[arg(long, default_value_t = 1, value_parser = parse_threads)]
         threads: usize,
-        /// Simulate only this many seconds of the scenario (quick checks).
+        /// Simulate only this many seconds of the scenario (quick checks; at most its 600 s).
         #[arg(long, allow_negative_numbers = true)]
         duration: Option<f64>,
     },
@@ -239,9 +241,11 @@ enum BenchCommand {
 enum ExperimentCommand {
     /// The park runs of 004_95e533f2514531b8.txt: each route N times (seeds 0..N), navigating by
     /// road-grid localization and by road MCL; reached-goal rate, wrong turns, recoveries,
-    /// time and localization error of both localizers.
+    /// time and localization error of both localizers. A route with several robots judges each
+    /// of them: `robot runs` = runs × robots with a route, and reached %, wrong turns and
+    /// recoveries count robot runs.
     Park {
-        /// Runs per route and localizer.
+        /// Runs per route and localizer (at most 100000).
         #[arg(long, default_value_t = 20)]
         runs: u64,
         /// One JSON object per row, one per line (and one per run with --per-run).
@@ -250,11 +254,11 @@ enum ExperimentCommand {
         /// With --json: also print every run.
         #[arg(long)]
         per_run: bool,
-        /// Routes (bundled scenario names or paths).
+        /// Routes (bundled scenario names or paths; each once).
         #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = sim::experiment::park::ROUTES.map(String::from))]
         routes: Vec<String>,
-        /// Worker threads (0 = one per core). Results do not depend on it.
-        #[arg(long, default_value_t = 0)]
+        /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
+        #[arg(long, default_value_t = 0, value_parser = parse_threads)]
         threads: usize,
     },
     /// The scan-matching protocol of 000_9f0113837c153763.txt on maze and hospital scans:
@@ -268,8 +272,9 @@ enum ExperimentCommand {
         /// up to 5000 generations (hours).
         #[arg(long)]
         full: bool,
-        /// Worker threads for the pairs (0 = one per core). Results do not depend on it.
-        #[arg(long, default_value_t = 0)]
+        /// Worker threads for the pairs (0 = one per core; at most 1024). Results do not
+        /// depend on it.
+        #[arg(long, default_value_t = 0, value_parser = parse_threads)]
         threads: usize,
         /// Seed of the pair selection and of the matchers.
         #[arg(long, default_value_t = 0)]
@@ -304,8 +309,8 @@ enum ExperimentCommand {
         /// Methods to run.
         #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = SLAM_METHODS.map(String::from))]
         methods: Vec<String>,
-        /// Kernel threads (0 = one per core). Results do not depend on it.
-        #[arg(long, default_value_t = 0)]
+        /// Kernel threads (0 = one per core; at most 1024). Results do not depend on it.
+        #[arg(long, default_value_t = 0, value_parser = parse_threads)]
         threads: usize,
     },
 }

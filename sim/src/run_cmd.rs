@@ -51,8 +51,9 @@ pub struct OutputArgs {
     /// robot with a laser and no SLAM; several: `-<robot>-<name>` after the stem.
     #[arg(long)]
     pub save_map: Option<PathBuf>,
-    /// Worker threads for parallel kernels (0 = one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads for parallel kernels (0 = one per core; at most 1024). Results do not
+    /// depend on it.
+    #[arg(long, default_value_t = 0, value_parser = parse_threads)]
     pub threads: usize,
     /// No progress bar and no table, only errors.
     #[arg(long)]
@@ -116,6 +117,18 @@ pub fn check_duration(d: f64) -> anyhow::Result<f64> {
         anyhow::bail!("--duration: expected a positive number of seconds, got {d}");
     }
     Ok(d)
+}
+
+/// The value parser of every `--threads`: 0 (one per core) or 1 to
+/// [`systems::core::pool::MAX_THREADS`], checked before any thread starts.
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    use systems::core::pool::MAX_THREADS;
+    let bad = || format!("expected 0 (one per core) or a thread count from 1 to {MAX_THREADS}");
+    let n: usize = s.trim().parse().map_err(|_| bad())?;
+    if n > MAX_THREADS {
+        return Err(bad());
+    }
+    Ok(n)
 }
 
 fn write_file(p: &Path, what: &str, text: String) -> anyhow::Result<()> {

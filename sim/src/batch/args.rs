@@ -32,7 +32,7 @@ pub struct BatchArgs {
     #[arg(long, default_value_t = 0)]
     pub jobs: usize,
     /// Kernel threads of each run (0 = one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = crate::run_cmd::parse_threads)]
     pub threads: usize,
     /// Output folder (default: batch-<scenario>-<A>-<B>, plus -shard<k>of<n> with --shard).
     #[arg(long)]

@@ -1,18 +1,18 @@
-//! Errors of the CARMEN reader: each names the file, the 1-based line, the message type and the
-//! field, and says what was expected.
+//! Errors of the CARMEN reader and writer: each names the file, the 1-based line, the message
+//! type and the field, and says what was expected.
 
 use thiserror::Error;
 
-/// Why a CARMEN log could not be read. Display gives `file:line: TYPE: …`.
+/// Why a CARMEN log could not be read or written. Display gives `file:line: TYPE: …`.
 #[derive(Debug, Error)]
 pub enum CarmenError {
-    /// The file could not be opened or read.
-    #[error("{file}: cannot read: {source}")]
-    Io {
-        file: String,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The file could not be opened or read. The cause is part of the message (not a source
+    /// too, which would print it twice in an error chain).
+    #[error("{file}: cannot read: {error}")]
+    Io { file: String, error: std::io::Error },
+    /// The file could not be created or written.
+    #[error("{file}: cannot write: {error}")]
+    Write { file: String, error: std::io::Error },
     /// The file is not a plain-text log (e.g. gzip-compressed).
     #[error("{file}: {message}")]
     NotText { file: String, message: String },

@@ -53,9 +53,9 @@ const ROBOTLASER2_FORMAT: &str = "ROBOTLASER2 laser_type start_angle field_of_vi
 /// them first); bytes that are not UTF-8 are replaced, which only matters inside skipped lines.
 pub fn read_carmen(path: &Path, opts: &CarmenReadOptions) -> Result<CarmenLog, CarmenError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| CarmenError::Io {
+    let bytes = std::fs::read(path).map_err(|error| CarmenError::Io {
         file: file.clone(),
-        source,
+        error,
     })?;
     if bytes.starts_with(&[0x1f, 0x8b]) {
         return Err(CarmenError::NotText {

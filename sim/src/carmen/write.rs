@@ -27,9 +27,9 @@ pub fn save_carmen(
     log: &CarmenLog,
     opts: &CarmenWriteOptions,
 ) -> Result<(), CarmenError> {
-    let io_err = |source| CarmenError::Io {
+    let io_err = |error| CarmenError::Write {
         file: path.display().to_string(),
-        source,
+        error,
     };
     let file = std::fs::File::create(path).map_err(io_err)?;
     let mut w = io::BufWriter::new(file);

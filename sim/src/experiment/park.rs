@@ -32,16 +32,24 @@ pub struct ParkRun {
     pub route: String,
     pub navigate_by: String,
     pub seed: u64,
+    /// The robot (a run judges every robot that has a route).
+    pub robot: String,
     pub sim_time_s: f64,
     pub road: RoadSummary,
 }
 
-/// One row of the table: a route driven by one localizer over all seeds.
+/// One row of the table: a route driven by one localizer over all seeds. A route with several
+/// robots judges each of them: `robot_runs` = runs × robots with a route, and the counts and
+/// percentages below are over robot runs.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct ParkRow {
     pub route: String,
     pub navigate_by: String,
-    pub runs: u32,
+    /// Simulation runs (seeds).
+    pub runs: u64,
+    /// Robots judged over all runs.
+    pub robot_runs: u32,
+    /// Robot runs that reached their goal.
     pub reached: u32,
     pub reached_percent: f64,
     pub wrong_turns: u32,
@@ -70,11 +78,15 @@ fn with_navigator(s: &Scenario, kind: RoadLocalizerKind, seed: u64) -> Scenario 
     s
 }
 
+/// The most runs per route and localizer `--runs` accepts.
+pub const MAX_RUNS: u64 = 100_000;
+
+/// Runs the experiment: rows in route, then localizer order, and every robot's run.
 pub fn run_park_experiment(o: &ParkOptions) -> anyhow::Result<(Vec<ParkRow>, Vec<ParkRun>)> {
-    if o.runs == 0 {
-        anyhow::bail!("--runs: expected at least 1");
+    if !(1..=MAX_RUNS).contains(&o.runs) {
+        anyhow::bail!("--runs: expected 1 to {MAX_RUNS}, got {}", o.runs);
     }
-    let mut jobs = Vec::new();
+    let mut scenarios: Vec<Scenario> = Vec::new();
     for name in &o.routes {
         let scenario = match std::path::Path::new(name).exists() {
             true => crate::load_scenario(std::path::Path::new(name))?,
@@ -83,16 +95,23 @@ pub fn run_park_experiment(o: &ParkOptions) -> anyhow::Result<(Vec<ParkRow>, Vec
         if !scenario.robots.iter().any(|r| r.route.is_some()) {
             anyhow::bail!("{name}: no robot has a `[robots.route]`");
         }
-        for kind in RoadLocalizerKind::ALL {
-            for seed in 0..o.runs {
-                jobs.push((
-                    scenario.name.clone(),
-                    with_navigator(&scenario, kind, seed),
-                    kind,
-                ));
-            }
+        if scenarios.iter().any(|s| s.name == scenario.name) {
+            anyhow::bail!(
+                "--routes: route `{}` is given twice ({name}); give each route once",
+                scenario.name
+            );
         }
+        scenarios.push(scenario);
     }
+    // (route, localizer, seed); each run's scenario is made when it starts
+    let jobs: Vec<(&Scenario, RoadLocalizerKind, u64)> = scenarios
+        .iter()
+        .flat_map(|s| {
+            RoadLocalizerKind::ALL
+                .into_iter()
+                .flat_map(move |kind| (0..o.runs).map(move |seed| (s, kind, seed)))
+        })
+        .collect();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(o.threads)
         .build()
@@ -101,27 +120,32 @@ pub fn run_park_experiment(o: &ParkOptions) -> anyhow::Result<(Vec<ParkRow>, Vec
     let total = jobs.len();
     let runs: Vec<anyhow::Result<Vec<ParkRun>>> = pool.install(|| {
         jobs.par_iter()
-            .map(|(route, s, kind)| {
+            .map(|&(route, kind, seed)| {
                 let opts = RunOptions {
                     rrd: None,
                     threads: 1,
                     progress: false,
                     trajectory_period: None,
                 };
-                let out = run_scenario(s, &opts)?;
+                let out = run_scenario(&with_navigator(route, kind, seed), &opts)?;
                 let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 if o.progress {
-                    eprintln!("[{n}/{total}] {route} by {} seed {}", kind.as_str(), s.seed);
+                    eprintln!(
+                        "[{n}/{total}] {} by {} seed {seed}",
+                        route.name,
+                        kind.as_str()
+                    );
                 }
                 Ok(out
                     .summary
                     .robots
                     .iter()
-                    .filter_map(|r| r.road.clone())
-                    .map(|road| ParkRun {
-                        route: route.clone(),
+                    .filter_map(|r| Some((r.name.clone(), r.road.clone()?)))
+                    .map(|(robot, road)| ParkRun {
+                        route: route.name.clone(),
                         navigate_by: kind.as_str().to_string(),
-                        seed: s.seed,
+                        seed,
+                        robot,
                         sim_time_s: out.summary.sim_time_s,
                         road,
                     })
@@ -134,23 +158,13 @@ pub fn run_park_experiment(o: &ParkOptions) -> anyhow::Result<(Vec<ParkRow>, Vec
         all.extend(r?);
     }
     let mut rows = Vec::new();
-    for name in &o.routes {
-        let route_name = all
-            .iter()
-            .find(|r| {
-                r.route == *name
-                    || std::path::Path::new(name)
-                        .file_stem()
-                        .is_some_and(|s| s == r.route.as_str())
-            })
-            .map(|r| r.route.clone())
-            .unwrap_or_else(|| name.clone());
+    for scenario in &scenarios {
         for kind in RoadLocalizerKind::ALL {
             let these: Vec<&ParkRun> = all
                 .iter()
-                .filter(|r| r.route == route_name && r.navigate_by == kind.as_str())
+                .filter(|r| r.route == scenario.name && r.navigate_by == kind.as_str())
                 .collect();
-            rows.push(row(&route_name, kind.as_str(), &these));
+            rows.push(row(&scenario.name, kind.as_str(), o.runs, &these));
         }
     }
     Ok((rows, all))
@@ -161,7 +175,8 @@ fn mean(v: impl Iterator<Item = f64>) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-fn row(route: &str, by: &str, runs: &[&ParkRun]) -> ParkRow {
+/// The row of `route` by localizer `by`: `seeds` runs, whose robots are `runs`.
+fn row(route: &str, by: &str, seeds: u64, runs: &[&ParkRun]) -> ParkRow {
     let reached = runs.iter().filter(|r| r.road.reached).count() as u32;
     let mut times: Vec<f64> = runs
         .iter()
@@ -184,7 +199,8 @@ fn row(route: &str, by: &str, runs: &[&ParkRun]) -> ParkRow {
     ParkRow {
         route: route.to_string(),
         navigate_by: by.to_string(),
-        runs: runs.len() as u32,
+        runs: seeds,
+        robot_runs: runs.len() as u32,
         reached,
         reached_percent: if runs.is_empty() {
             0.0
@@ -208,10 +224,11 @@ fn row(route: &str, by: &str, runs: &[&ParkRun]) -> ParkRow {
 pub fn table(rows: &[ParkRow]) -> String {
     let f = |v: Option<f64>, p: usize| v.map_or("-".to_string(), |v| format!("{v:.p$}"));
     let mut s = format!(
-        "{:<18} {:<10} {:>5} {:>8} {:>6} {:>6} {:>8} | {:>22} | {:>22} | {:>8}\n",
+        "{:<18} {:<10} {:>5} {:>6} {:>8} {:>6} {:>6} {:>8} | {:>22} | {:>22} | {:>8}\n",
         "route",
         "nav by",
         "runs",
+        "robot",
         "reached",
         "wrong",
         "recov",
@@ -221,10 +238,11 @@ pub fn table(rows: &[ParkRow]) -> String {
         "off-road"
     );
     s += &format!(
-        "{:<18} {:<10} {:>5} {:>8} {:>6} {:>6} {:>8} | {:>22} | {:>22} | {:>8}\n",
+        "{:<18} {:<10} {:>5} {:>6} {:>8} {:>6} {:>6} {:>8} | {:>22} | {:>22} | {:>8}\n",
         "",
         "",
         "",
+        "runs",
         "%",
         "turns",
         "",
@@ -235,10 +253,11 @@ pub fn table(rows: &[ParkRow]) -> String {
     );
     for r in rows {
         s += &format!(
-            "{:<18} {:<10} {:>5} {:>8.1} {:>6} {:>6} {:>8} | {:>6} {:>6} {:>8} | {:>6} {:>6} {:>8} | {:>8.1}\n",
+            "{:<18} {:<10} {:>5} {:>6} {:>8.1} {:>6} {:>6} {:>8} | {:>6} {:>6} {:>8} | {:>6} {:>6} {:>8} | {:>8.1}\n",
             r.route,
             r.navigate_by,
             r.runs,
+            r.robot_runs,
             r.reached_percent,
             r.wrong_turns,
             r.recoveries,
@@ -253,4 +272,51 @@ pub fn table(rows: &[ParkRow]) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn robot_run(robot: &str, reached: bool) -> ParkRun {
+        ParkRun {
+            route: "three".into(),
+            navigate_by: "road_grid".into(),
+            seed: 0,
+            robot: robot.into(),
+            sim_time_s: 10.0,
+            road: RoadSummary {
+                goal: "g".into(),
+                reached,
+                arrival_time_s: reached.then_some(5.0),
+                final_distance_m: None,
+                planned_length_m: None,
+                wrong_turns: 1,
+                recoveries: 0,
+                replans: 0,
+                plan_failures: 0,
+                junctions_left_right_compass: [0; 3],
+                off_road_time_s: 0.0,
+                sonar_stop_time_s: 0.0,
+                navigated_by: "road_grid".into(),
+                localizers: Default::default(),
+            },
+        }
+    }
+
+    #[test]
+    fn a_row_counts_runs_as_runs_and_robots_apart() {
+        // one run of a route with three robots, two of which arrive
+        let runs = [
+            robot_run("r1", true),
+            robot_run("r2", true),
+            robot_run("r3", false),
+        ];
+        let r = row("three", "road_grid", 1, &runs.iter().collect::<Vec<_>>());
+        assert_eq!((r.runs, r.robot_runs, r.reached), (1, 3, 2));
+        assert!((r.reached_percent - 200.0 / 3.0).abs() < 1e-9);
+        assert_eq!(r.wrong_turns, 3);
+        let table = table(&[r]);
+        assert!(table.contains("robot"), "{table}");
+    }
 }

@@ -105,12 +105,23 @@ pub fn run_slam_experiment(o: &SlamExperimentOptions) -> anyhow::Result<Vec<Slam
     }
     let pool = KernelPool::new(o.threads)
         .map_err(|e| anyhow::anyhow!("cannot start {} kernel threads: {e}", o.threads))?;
-    let mut rows = Vec::new();
+    // every scenario loads and has a robot to log before the first (long) simulation
+    let mut scenarios = Vec::new();
     for name in &o.scenarios {
         let scenario = match std::path::Path::new(name).exists() {
             true => crate::load_scenario(std::path::Path::new(name))?,
             false => bundled(name)?,
         };
+        if crate::carmen_out::exported_robots(&scenario).is_empty() {
+            anyhow::bail!(
+                "--scenarios: {name}: no robot with a laser and wheel encoders (the methods run \
+                 on its laser scans and odometry)"
+            );
+        }
+        scenarios.push(scenario);
+    }
+    let mut rows = Vec::new();
+    for scenario in scenarios {
         let log = simulate(&scenario, o)?;
         rows.extend(judge_methods(
             &scenario, &log, &o.methods, &pool, o.progress,

@@ -55,8 +55,8 @@ pub struct ReplayArgs {
     /// Override the seed of the localizers' random numbers (default: the recorded run's).
     #[arg(long)]
     pub seed: Option<u64>,
-    /// Override a scenario key, as `sim batch --set` does (`robots.0.localizers.0.particles=500`).
-    /// Repeatable.
+    /// Override a scenario key, as `sim batch --set` does
+    /// (`robots.0.localization.0.max_particles=500`). Repeatable.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     pub sets: Vec<String>,
     /// Replay only this robot of the scenario (needed with topic flags when it has several).
@@ -65,8 +65,9 @@ pub struct ReplayArgs {
     /// sensor_msgs/LaserScan topic (default: /<robot>/scan in our files, /scan otherwise).
     #[arg(long)]
     pub scan_topic: Option<String>,
-    /// nav_msgs/Odometry topic whose poses replace wheel odometry (default for foreign files:
-    /// /odom; our files replay the encoder ticks of /<robot>/joint_states).
+    /// nav_msgs/Odometry (or geometry_msgs/PoseStamped) topic whose poses replace wheel
+    /// odometry (default for foreign files: /odom; our files replay the encoder ticks of
+    /// /<robot>/joint_states).
     #[arg(long)]
     pub odom_topic: Option<String>,
     /// sensor_msgs/JointState topic of the wheel encoders (default: /<robot>/joint_states).

@@ -64,24 +64,7 @@ impl TimeBase<'_> {
 /// The messages of `topic` as `T`; a missing topic or another type is an error naming the
 /// file, the topic and what the file has.
 fn read_topic<T: RosMessage>(rec: &McapRecording, topic: &str) -> anyhow::Result<Vec<T>> {
-    if rec.channel(topic).is_none() {
-        let mut have: Vec<String> = rec
-            .channels
-            .iter()
-            .map(|c| format!("{} ({})", c.topic, c.schema_name))
-            .collect();
-        have.sort();
-        bail!(
-            "{}: no topic {topic} (expected {}); the file has: {}",
-            rec.path.display(),
-            T::NAME,
-            if have.is_empty() {
-                "no topics".to_string()
-            } else {
-                have.join(", ")
-            }
-        );
-    }
+    check_topic(rec, topic, T::NAME)?;
     let msgs: Vec<T> = rec
         .decode_topic::<T>(topic)?
         .into_iter()
@@ -91,6 +74,29 @@ fn read_topic<T: RosMessage>(rec: &McapRecording, topic: &str) -> anyhow::Result
         bail!("{}: topic {topic} has no messages", rec.path.display());
     }
     Ok(msgs)
+}
+
+/// An error naming the file, the topic, the `expected` message type(s) and what the file has,
+/// if the file has no `topic`.
+fn check_topic(rec: &McapRecording, topic: &str, expected: &str) -> anyhow::Result<()> {
+    if rec.channel(topic).is_none() {
+        let mut have: Vec<String> = rec
+            .channels
+            .iter()
+            .map(|c| format!("{} ({})", c.topic, c.schema_name))
+            .collect();
+        have.sort();
+        bail!(
+            "{}: no topic {topic} (expected {expected}); the file has: {}",
+            rec.path.display(),
+            if have.is_empty() {
+                "no topics".to_string()
+            } else {
+                have.join(", ")
+            }
+        );
+    }
+    Ok(())
 }
 
 /// The schema of `topic`, if the file has it.
@@ -136,6 +142,11 @@ fn read_poses(
     topic: &str,
     time: &TimeBase<'_>,
 ) -> anyhow::Result<Vec<(f64, Pose2)>> {
+    check_topic(
+        rec,
+        topic,
+        &format!("{} or {}", Odometry::NAME, PoseStamped::NAME),
+    )?;
     let mut out: Vec<(f64, Pose2)> = if schema_of(rec, topic) == Some(Odometry::NAME) {
         read_topic::<Odometry>(rec, topic)?
             .iter()

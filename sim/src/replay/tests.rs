@@ -262,6 +262,14 @@ fn missing_topics_attachments_and_damage_are_clear_errors() {
     // ours, with a robot the scenario does not have
     let e = msg(&args(&own, &["--robot", "nobody"]));
     assert!(e.contains("nobody"), "{e}");
+    // a missing odometry topic: the message names both types read_poses accepts
+    let e = msg(&args(&own, &["--robot", "r1", "--odom-topic", "/nosuch"]));
+    assert!(
+        e.contains("no topic /nosuch")
+            && e.contains("nav_msgs/msg/Odometry")
+            && e.contains("geometry_msgs/msg/PoseStamped"),
+        "{e}"
+    );
     // a bad override names the key
     let e = msg(&args(&own, &["--set", "robots.0.sensors.laser.rate=-1"]));
     assert!(e.contains("robots.0.sensors.laser.rate"), "{e}");
@@ -306,4 +314,28 @@ fn a_recording_without_its_scenario_attachment_needs_scenario() {
         e.contains("stripped.mcap") && e.contains("no scenario.toml attachment"),
         "{e}"
     );
+}
+
+/// The `--set` example of `sim replay --help` is a key the scenario parser takes.
+#[test]
+fn the_set_example_of_the_help_applies_to_a_bundled_scenario() {
+    use clap::Args;
+    let cmd = ReplayArgs::augment_args(clap::Command::new("replay"));
+    let help = cmd
+        .get_arguments()
+        .find(|a| a.get_id() == "sets")
+        .and_then(|a| a.get_help())
+        .map(|h| h.to_string())
+        .unwrap();
+    // the backquoted `key=value` (the other quote is a command)
+    let example = help
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .find(|s| s.contains('='))
+        .unwrap_or_else(|| panic!("no example in {help}"));
+    let source = crate::batch::sets::Source::load(&scenario_file("hospital_patrol")).unwrap();
+    let plan = crate::batch::sets::plan_sets(&[example.to_string()], &[], &[]).unwrap();
+    let sc = source.scenario(&plan.sets[0]);
+    assert!(sc.is_ok(), "{example}: {:?}", sc.err());
 }

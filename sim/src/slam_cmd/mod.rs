@@ -74,8 +74,9 @@ pub struct SlamArgs {
     /// Seed of the SLAM system's random stream (for randomized SLAM types).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Worker threads for parallel kernels (0 = one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads for parallel kernels (0 = one per core; at most 1024). Results do not
+    /// depend on it.
+    #[arg(long, default_value_t = 0, value_parser = crate::run_cmd::parse_threads)]
     pub threads: usize,
 }
 

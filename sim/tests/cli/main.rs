@@ -3,6 +3,7 @@
 mod carmen;
 mod interrupt;
 mod matching;
+mod option_limits;
 mod replay;
 
 use std::path::Path;

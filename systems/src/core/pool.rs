@@ -13,6 +13,19 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
+/// The most workers a pool may have: far more than any machine's cores (results do not depend
+/// on the count), few enough to start in well under a second.
+pub const MAX_THREADS: usize = 1024;
+
+/// Why a [`KernelPool`] could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PoolError {
+    #[error("{0} threads is more than the {MAX_THREADS} a pool may have")]
+    TooMany(usize),
+    #[error(transparent)]
+    Build(#[from] rayon::ThreadPoolBuildError),
+}
+
 /// How long workers stay awake after a parallel section, waiting for the next one.
 const STAY_AWAKE: Duration = Duration::from_millis(3);
 
@@ -30,8 +43,12 @@ pub struct KernelPool {
 }
 
 impl KernelPool {
-    /// A pool with `threads` workers (0 = one per core).
-    pub fn new(threads: usize) -> Result<Self, rayon::ThreadPoolBuildError> {
+    /// A pool with `threads` workers (0 = one per core); an error, not a panic, when there are
+    /// more than [`MAX_THREADS`] or a worker cannot be started.
+    pub fn new(threads: usize) -> Result<Self, PoolError> {
+        if threads > MAX_THREADS {
+            return Err(PoolError::TooMany(threads));
+        }
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .thread_name(|i| format!("sim-kernel-{i}"))
@@ -120,6 +137,15 @@ impl KernelPool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn more_threads_than_the_limit_is_an_error_before_any_starts() {
+        for n in [MAX_THREADS + 1, 1 << 32] {
+            let e = KernelPool::new(n).err().expect("too many threads accepted");
+            assert!(matches!(e, PoolError::TooMany(t) if t == n), "{e}");
+            assert!(e.to_string().contains("1024"), "{e}");
+        }
+    }
 
     #[test]
     fn for_each_visits_every_item_once_whatever_the_count() {
