@@ -1,7 +1,11 @@
 //! `sim batch` arguments and the parsing of their values: the seed range `A..B`, the shard `k/n`,
 //! `key=value` overrides and the comma-separated value lists of `--sweep` and `--zip`.
 
+use clap::builder::RangedU64ValueParser;
 use std::path::PathBuf;
+
+/// The most runs `--jobs` may ask for at the same time.
+pub const MAX_WORKERS: u64 = 1024;
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct BatchArgs {
@@ -28,8 +32,10 @@ pub struct BatchArgs {
     /// values of every --zip form one axis point, combined with the sweeps.
     #[arg(long = "zip", value_name = "KEY=V1,V2,...")]
     pub zips: Vec<String>,
-    /// Runs at the same time (0 = one per core; default: one per core).
-    #[arg(long, default_value_t = 0)]
+    /// Runs at the same time (0 = one per core; default: one per core; at most 1024, and never
+    /// more than the batch has runs).
+    #[arg(long, default_value_t = 0,
+          value_parser = RangedU64ValueParser::<usize>::new().range(0..=MAX_WORKERS))]
     pub jobs: usize,
     /// Kernel threads of each run (0 = one per core). Results do not depend on it.
     #[arg(long, default_value_t = 1, value_parser = crate::run_cmd::parse_threads)]
@@ -123,8 +129,9 @@ pub fn split_key_value<'a>(flag: &str, s: &'a str) -> anyhow::Result<(&'a str, &
 }
 
 /// Splits a value list at the commas outside brackets, braces and quotes:
-/// `[1,2],[3,4]` → `[1,2]`, `[3,4]`.
-pub fn split_values(flag: &str, s: &str) -> anyhow::Result<Vec<String>> {
+/// `[1,2],[3,4]` → `[1,2]`, `[3,4]`. Errors name `flag` and the whole argument `arg`
+/// (`KEY=V1,V2,...`) the list `s` comes from.
+pub fn split_values(flag: &str, arg: &str, s: &str) -> anyhow::Result<Vec<String>> {
     let mut out = Vec::new();
     let mut cur = String::new();
     let mut depth = 0i32;
@@ -145,12 +152,12 @@ pub fn split_values(flag: &str, s: &str) -> anyhow::Result<Vec<String>> {
         cur.push(c);
     }
     if quote.is_some() || depth != 0 {
-        anyhow::bail!("{flag} {s}: unbalanced quotes or brackets in the value list");
+        anyhow::bail!("{flag} {arg}: unbalanced quotes or brackets in the value list");
     }
     out.push(cur.trim().to_string());
     if let Some(i) = out.iter().position(String::is_empty) {
         anyhow::bail!(
-            "{flag} {s}: value {} of the list is empty (expected V1,V2,...)",
+            "{flag} {arg}: value {} of the list is empty (expected V1,V2,...)",
             i + 1
         );
     }
@@ -207,10 +214,18 @@ mod tests {
             .to_string();
         assert!(e.contains("expected KEY=VALUE"), "{e}");
         assert_eq!(
-            split_values("--sweep", "[1,2], [3,4],'a,b',{x=1,y=2}").unwrap(),
+            split_values("--sweep", "k=…", "[1,2], [3,4],'a,b',{x=1,y=2}").unwrap(),
             ["[1,2]", "[3,4]", "'a,b'", "{x=1,y=2}"]
         );
-        assert!(split_values("--sweep", "1,,2").is_err());
-        assert!(split_values("--sweep", "[1,2").is_err());
+        assert!(split_values("--sweep", "k=1,,2", "1,,2").is_err());
+        assert!(split_values("--sweep", "k=[1,2", "[1,2").is_err());
+        // the message names the key, whichever value is empty
+        for (arg, list, i) in [("k=", "", 1), ("k=,", ",", 1), ("k=0.5,", "0.5,", 2)] {
+            let e = split_values("--zip", arg, list).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!("--zip {arg}: value {i} of the list is empty (expected V1,V2,...)")
+            );
+        }
     }
 }

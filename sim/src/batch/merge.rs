@@ -1,11 +1,14 @@
 //! `sim batch-merge OUT DIR...`: joins the `runs.jsonl` of the shards of one batch (`--shard
-//! k/n` runs, e.g. one per Slurm array task) into one folder with `runs.csv`, `runs.jsonl` and
-//! `aggregate.csv` as a single `sim batch` would have written them, and prints the table.
+//! k/n` runs, e.g. one per Slurm array task) into one folder with `runs.csv`, `runs.jsonl`,
+//! `aggregate.csv` and `batch.json` as a single `sim batch` would have written them, and prints
+//! the table. Shards of different batches (by their `batch.json`), a shard given twice, a
+//! missing shard and an output folder that is one of the shards are errors.
 
 use super::output::{self, Row};
-use super::{BatchReport, aggregate};
+use super::{BatchReport, aggregate, manifest};
 use serde::de::{Deserializer, MapAccess, Visitor};
 use serde_json::Value as Json;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args, Clone, Debug)]
@@ -74,12 +77,110 @@ fn get(row: &Row, k: &str) -> u64 {
         .unwrap_or(0)
 }
 
+/// Refuses an output folder that is one of the shards (merging would overwrite its files).
+fn check_out_is_no_shard(a: &MergeArgs) -> anyhow::Result<()> {
+    let Ok(out) = a.out.canonicalize() else {
+        return Ok(()); // not there yet, so no shard
+    };
+    for dir in &a.shards {
+        if dir.canonicalize().is_ok_and(|d| d == out) {
+            anyhow::bail!(
+                "{}: the output folder is also given as a shard ({}); merging would overwrite \
+                 that shard's files: write the merged files to another folder",
+                a.out.display(),
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuses shards of different batches, naming the two folders and what differs.
+fn check_same_batch(shards: &[(manifest::Manifest, &Path)]) -> anyhow::Result<()> {
+    let Some((first, first_dir)) = shards.first() else {
+        return Ok(());
+    };
+    for (m, dir) in &shards[1..] {
+        if let Some((what, a, b)) = first.difference(m) {
+            anyhow::bail!(
+                "{} and {} are not shards of the same batch: {what} is {a} in {} but {b} in {}",
+                first_dir.display(),
+                dir.display(),
+                first_dir.display(),
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a shard given twice and a batch with shards missing (naming them); the shards are
+/// of one batch.
+fn check_complete(shards: &[(manifest::Manifest, &Path)]) -> anyhow::Result<()> {
+    let Some((first, _)) = shards.first() else {
+        return Ok(());
+    };
+    let n = first.shards;
+    let mut seen: BTreeMap<usize, &Path> = BTreeMap::new();
+    for (m, dir) in shards {
+        if let Some(before) = seen.insert(m.shard, dir) {
+            anyhow::bail!(
+                "shard {}/{n} is in both {} and {}: merge each shard once",
+                m.shard,
+                before.display(),
+                dir.display()
+            );
+        }
+    }
+    let missing = n - seen.len();
+    if missing > 0 {
+        let first: Vec<String> = (0..n)
+            .filter(|k| !seen.contains_key(k))
+            .take(10)
+            .map(|k| format!("{k}/{n}"))
+            .collect();
+        let listed = if missing > first.len() {
+            format!("{}, … ({missing} in all)", first.join(", "))
+        } else {
+            first.join(", ")
+        };
+        anyhow::bail!(
+            "shard{} {listed} of the batch {} missing: merge every shard (--shard K/{n} for K \
+             from 0 to {})",
+            if missing == 1 { "" } else { "s" },
+            if missing == 1 { "is" } else { "are" },
+            n - 1
+        );
+    }
+    Ok(())
+}
+
 /// `sim batch-merge`.
 pub fn merge_command(a: &MergeArgs) -> anyhow::Result<BatchReport> {
     let started = std::time::Instant::now();
+    check_out_is_no_shard(a)?;
+    let manifests = a
+        .shards
+        .iter()
+        .map(|dir| Ok((manifest::Manifest::read(dir)?, dir.as_path())))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    check_same_batch(&manifests)?;
     let mut rows: Vec<(Row, &Path)> = Vec::new();
-    for dir in &a.shards {
-        rows.extend(read_rows(dir)?.into_iter().map(|r| (r, dir.as_path())));
+    for (m, dir) in &manifests {
+        let shard_rows = read_rows(dir)?;
+        if shard_rows.len() != m.shard_runs() {
+            anyhow::bail!(
+                "{}: {} runs, but shard {}/{} of a batch of {} jobs has {}: the file is \
+                 incomplete or edited",
+                dir.join("runs.jsonl").display(),
+                shard_rows.len(),
+                m.shard,
+                m.shards,
+                m.jobs,
+                m.shard_runs()
+            );
+        }
+        rows.extend(shard_rows.into_iter().map(|r| (r, *dir)));
     }
     rows.sort_by_key(|(r, _)| get(r, "job"));
     for w in rows.windows(2) {
@@ -92,14 +193,8 @@ pub fn merge_command(a: &MergeArgs) -> anyhow::Result<BatchReport> {
             );
         }
     }
+    check_complete(&manifests)?;
     let rows: Vec<Row> = rows.into_iter().map(|(r, _)| r).collect();
-    let expected = rows.last().map_or(0, |r| get(r, "job") + 1) as usize;
-    if rows.len() < expected {
-        eprintln!(
-            "warning: {} of jobs 0..{expected} are missing (a shard not merged, or still running?)",
-            expected - rows.len()
-        );
-    }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| anyhow::anyhow!("{}: cannot create the folder: {e}", a.out.display()))?;
     let cols = output::columns(&rows);
@@ -108,6 +203,14 @@ pub fn merge_command(a: &MergeArgs) -> anyhow::Result<BatchReport> {
     let sets = rows.iter().map(|r| get(r, "set") + 1).max().unwrap_or(0) as usize;
     let stats = aggregate::aggregate(sets, &cols, &rows);
     aggregate::write_aggregate(&a.out.join("aggregate.csv"), &stats)?;
+    if let Some((m, _)) = manifests.first() {
+        let whole = manifest::Manifest {
+            shard: 0,
+            shards: 1,
+            ..m.clone()
+        };
+        whole.write(&a.out)?;
+    }
     let table = aggregate::table(&stats);
     let failed = rows
         .iter()

@@ -2,12 +2,14 @@
 //! and `--zip` overrides, in parallel on a pool of `--jobs` workers. Each run is isolated and
 //! deterministic (same set and seed ⇒ same summary, whatever `--jobs` and `--threads`); a set
 //! that fails to load or a run that fails is reported and counted, and the others go on. Writes
-//! `runs.csv`, `runs.jsonl` (one row per run, every summary metric) and `aggregate.csv`
-//! (mean, std, median, p95 per set and metric), and prints the table of the main metrics.
+//! `runs.csv`, `runs.jsonl` (one row per run, every summary metric), `aggregate.csv`
+//! (mean, std, median, p95 per set and metric) and `batch.json` ([`manifest`]), and prints the
+//! table of the main metrics.
 //! `sim batch-merge` ([`merge`]) joins the outputs of the shards of one batch.
 
 pub mod aggregate;
 pub mod args;
+pub mod manifest;
 pub mod merge;
 pub mod output;
 pub mod params;
@@ -85,6 +87,8 @@ pub struct Batch {
     /// Per set, its scenario (None: no job of this shard uses it).
     pub scenarios: Vec<Option<Result<Scenario, String>>>,
     pub jobs: Vec<runner::Job>,
+    /// The batch and shard, as `batch.json` records them.
+    pub manifest: manifest::Manifest,
 }
 
 /// Parses the arguments and loads every parameter set a job of the shard uses; fails if the
@@ -93,9 +97,22 @@ pub fn prepare(a: &BatchArgs) -> anyhow::Result<Batch> {
     let seeds = args::parse_seeds(&a.seeds)?;
     let shard = a.shard.as_deref().map(args::parse_shard).transpose()?;
     let plan = sets::plan_sets(&a.sets, &a.sweeps, &a.zips)?;
+    let total = runner::total_runs(plan.sets.len(), &seeds)?;
     let source = sets::Source::load(&scenario_path(Some(&a.scenario))?)?;
     let duration = a.duration.map(check_duration).transpose()?;
-    let jobs = runner::plan_jobs(plan.sets.len(), seeds, shard);
+    let (shard_k, shards) = shard.unwrap_or((0, 1));
+    let manifest = manifest::Manifest {
+        scenario: source.plain.name.clone(),
+        seeds: format!("{}..{}", seeds.start, seeds.end),
+        duration,
+        set: a.sets.clone(),
+        sweep: a.sweeps.clone(),
+        zip: a.zips.clone(),
+        jobs: total,
+        shard: shard_k,
+        shards,
+    };
+    let jobs = runner::plan_jobs(plan.sets.len(), seeds, shard)?;
     let scenarios: Vec<Option<Result<Scenario, String>>> = (0..plan.sets.len())
         .map(|i| {
             jobs.iter().any(|j| j.set == i).then(|| {
@@ -130,6 +147,7 @@ pub fn prepare(a: &BatchArgs) -> anyhow::Result<Batch> {
         sets: plan.sets,
         scenarios,
         jobs,
+        manifest,
     })
 }
 
@@ -261,11 +279,7 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
             if b.sets.len() == 1 { "" } else { "s" },
             a.seeds,
             b.jobs.len(),
-            if a.jobs == 0 {
-                std::thread::available_parallelism().map_or(1, |n| n.get())
-            } else {
-                a.jobs
-            }
+            runner::worker_count(a.jobs, b.jobs.len())
         );
     }
     let rrd_dir = a.rrd.then_some(out_dir.as_path());
@@ -285,14 +299,15 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
     output::write_jsonl(&out_dir.join("runs.jsonl"), &rows)?;
     let stats = aggregate::aggregate(b.sets.len(), &cols, &rows);
     aggregate::write_aggregate(&out_dir.join("aggregate.csv"), &stats)?;
+    b.manifest.write(&out_dir)?;
     let table = aggregate::table(&stats);
     let failed = done.iter().filter(|f| f.result.is_err()).count();
     let wall_s = started.elapsed().as_secs_f64();
     if !a.quiet {
         print!("{table}");
         println!(
-            "{} runs, {failed} failed, in {wall_s:.1} s; runs.csv, runs.jsonl and aggregate.csv \
-             written to {}",
+            "{} runs, {failed} failed, in {wall_s:.1} s; runs.csv, runs.jsonl, aggregate.csv and \
+             batch.json written to {}",
             done.len(),
             out_dir.display()
         );

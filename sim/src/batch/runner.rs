@@ -22,22 +22,60 @@ pub struct Job {
     pub seed: u64,
 }
 
-/// The jobs of `sets` parameter sets × `seeds`, or of shard `k/n` of them: jobs k, k+n, …
+/// The most runs a batch may have (parameter sets × seeds, all shards together).
+pub const MAX_RUNS: usize = 1_000_000;
+
+/// The number of runs of `sets` parameter sets × `seeds`, or the error naming `--seeds` (and
+/// `--sweep`/`--zip` when they make several sets) if it is above [`MAX_RUNS`].
+pub fn total_runs(sets: usize, seeds: &std::ops::Range<u64>) -> anyhow::Result<usize> {
+    let per_set = seeds.end.saturating_sub(seeds.start);
+    let total = (sets as u128).checked_mul(u128::from(per_set));
+    match total.and_then(|t| usize::try_from(t).ok()) {
+        Some(t) if t <= MAX_RUNS => Ok(t),
+        _ => {
+            let runs = total.map_or("too many".to_string(), |t| t.to_string());
+            let seeds = format!("--seeds {}..{}", seeds.start, seeds.end);
+            let what = if sets == 1 {
+                format!("{seeds} makes {runs} runs")
+            } else {
+                format!("{seeds} × {sets} parameter sets (--sweep/--zip) makes {runs} runs")
+            };
+            anyhow::bail!(
+                "{what}, more than the {MAX_RUNS} a batch may have (split it into several batches)"
+            )
+        }
+    }
+}
+
+/// The jobs of `sets` parameter sets × `seeds`, or of shard `k/n` of them: jobs k, k+n, …;
+/// an error if the batch has more than [`MAX_RUNS`] runs.
 pub fn plan_jobs(
     sets: usize,
     seeds: std::ops::Range<u64>,
     shard: Option<(usize, usize)>,
-) -> Vec<Job> {
+) -> anyhow::Result<Vec<Job>> {
+    let total = total_runs(sets, &seeds)?;
     let per_set = (seeds.end - seeds.start) as usize;
     let (k, n) = shard.unwrap_or((0, 1));
-    (0..sets * per_set)
-        .filter(|i| i % n == k)
+    Ok((k..total)
+        .step_by(n.max(1))
         .map(|index| Job {
             index,
             set: index / per_set,
             seed: seeds.start + (index % per_set) as u64,
         })
-        .collect()
+        .collect())
+}
+
+/// The workers that run `jobs` jobs when `--jobs` asks for `requested` (0 = one per core):
+/// never more than the jobs, at least one.
+pub fn worker_count(requested: usize, jobs: usize) -> usize {
+    let wanted = if requested == 0 {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    } else {
+        requested
+    };
+    wanted.min(jobs).max(1)
 }
 
 /// What became of a job, with its wall time (s).
@@ -73,8 +111,8 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
     format!("panicked: {msg}")
 }
 
-/// Runs `work` on every job with `workers` threads (0 = one per core), catching errors and
-/// panics; results come back in job order. `failed_before` runs already counted as failed
+/// Runs `work` on every job with `workers` threads (0 = one per core; never more than the jobs),
+/// catching errors and panics; results come back in job order. `failed_before` runs already counted as failed
 /// (shown on the bar).
 pub fn run_jobs<T: Send>(
     jobs: &[Job],
@@ -84,6 +122,10 @@ pub fn run_jobs<T: Send>(
     describe: impl Fn(&Job) -> String + Sync,
     work: impl Fn(&Job) -> anyhow::Result<T> + Sync,
 ) -> anyhow::Result<Vec<Finished<T>>> {
+    if jobs.is_empty() {
+        return Ok(Vec::new());
+    }
+    let workers = worker_count(workers, jobs.len());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(workers)
         .thread_name(|i| format!("sim-batch-{i}"))
@@ -132,7 +174,7 @@ mod tests {
 
     #[test]
     fn jobs_and_shards() {
-        let all = plan_jobs(2, 5..8, None);
+        let all = plan_jobs(2, 5..8, None).unwrap();
         assert_eq!(all.len(), 6);
         assert_eq!(
             all[0],
@@ -150,20 +192,60 @@ mod tests {
                 seed: 6
             }
         );
-        let a = plan_jobs(2, 5..8, Some((0, 4)));
-        let b = plan_jobs(2, 5..8, Some((1, 4)));
+        let a = plan_jobs(2, 5..8, Some((0, 4))).unwrap();
+        let b = plan_jobs(2, 5..8, Some((1, 4))).unwrap();
         let idx: Vec<usize> = a.iter().chain(&b).map(|j| j.index).collect();
         assert_eq!(idx, [0, 4, 1, 5]);
         let mut union: Vec<Job> = (0..4)
-            .flat_map(|k| plan_jobs(2, 5..8, Some((k, 4))))
+            .flat_map(|k| plan_jobs(2, 5..8, Some((k, 4))).unwrap())
             .collect();
         union.sort_by_key(|j| j.index);
         assert_eq!(union, all);
     }
 
     #[test]
+    fn too_many_runs_are_refused_before_planning() {
+        assert_eq!(
+            plan_jobs(1, 0..MAX_RUNS as u64, Some((3, 4)))
+                .unwrap()
+                .len(),
+            MAX_RUNS / 4
+        );
+        for (sets, seeds, want) in [
+            (
+                1,
+                0..u64::MAX,
+                "--seeds 0..18446744073709551615 makes 18446744073709551615 runs",
+            ),
+            (
+                1,
+                0..MAX_RUNS as u64 + 1,
+                "makes 1000001 runs, more than the 1000000",
+            ),
+            (
+                3,
+                0..6148914691236517206,
+                "× 3 parameter sets (--sweep/--zip) makes 18446744073709551618 runs",
+            ),
+            (2, 0..9223372036854775808, "makes 18446744073709551616 runs"),
+            (2, 0..500_001, "--seeds 0..500001 × 2 parameter sets"),
+        ] {
+            let e = plan_jobs(sets, seeds, None).unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
+        }
+    }
+
+    #[test]
+    fn workers_never_outnumber_the_jobs() {
+        assert_eq!(worker_count(5000, 1), 1);
+        assert_eq!(worker_count(3, 10), 3);
+        assert_eq!(worker_count(0, 1), 1);
+        assert_eq!(worker_count(2, 0), 1);
+    }
+
+    #[test]
     fn errors_and_panics_do_not_stop_the_others() {
-        let jobs = plan_jobs(1, 0..6, None);
+        let jobs = plan_jobs(1, 0..6, None).unwrap();
         let bar = ProgressBar::hidden();
         let out = run_jobs(
             &jobs,

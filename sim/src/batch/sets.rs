@@ -5,6 +5,7 @@
 
 use super::args::{split_key_value, split_values};
 use super::params::{Override, blame};
+use super::runner::MAX_RUNS;
 use crate::scenario::{Scenario, parse_scenario};
 use std::path::{Path, PathBuf};
 use toml_edit::DocumentMut;
@@ -20,7 +21,7 @@ pub struct SetPlan {
 
 fn overrides_of(flag: &'static str, arg: &str) -> anyhow::Result<Vec<Override>> {
     let (k, v) = split_key_value(flag, arg)?;
-    split_values(flag, v)?
+    split_values(flag, arg, v)?
         .iter()
         .map(|v| Override::new(flag, k, v))
         .collect()
@@ -78,6 +79,16 @@ pub fn plan_sets(sets: &[String], sweeps: &[String], zips: &[String]) -> anyhow:
                 flags[i]
             );
         }
+    }
+    let lengths: Vec<usize> = axes.iter().map(Vec::len).collect();
+    let count = lengths.iter().try_fold(1usize, |n, &l| n.checked_mul(l));
+    if count.is_none_or(|n| n > MAX_RUNS) {
+        let product: Vec<String> = lengths.iter().map(usize::to_string).collect();
+        anyhow::bail!(
+            "--sweep/--zip: {} parameter sets ({}), more than the {MAX_RUNS} runs a batch may have",
+            count.map_or("too many".to_string(), |n| n.to_string()),
+            product.join(" × ")
+        );
     }
     // odometer over the axes, the first axis varying slowest
     let mut out = Vec::new();
@@ -224,5 +235,18 @@ mod tests {
         assert!(e(&[], &[], &["a=1,2", "b=1"]).contains("every --zip needs the same number"));
         assert!(e(&["duration"], &[], &[]).contains("--set duration: expected KEY=VALUE"));
         assert!(e(&[], &["seed=1,2"], &[]).contains("the seed of each run comes from --seeds"));
+        // the product is refused before it is built
+        let values = (0..1000)
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(",");
+        let sweeps: Vec<String> = ["a", "b"].iter().map(|k| format!("{k}={values}")).collect();
+        let zips: Vec<String> = ["c", "d"].iter().map(|k| format!("{k}={values}")).collect();
+        let sweeps: Vec<&str> = sweeps.iter().map(String::as_str).collect();
+        let zips: Vec<&str> = zips.iter().map(String::as_str).collect();
+        assert!(e(&[], &sweeps, &zips).contains(
+            "--sweep/--zip: 1000000000 parameter sets (1000 × 1000 × 1000), more than the \
+                 1000000 runs a batch may have"
+        ));
     }
 }

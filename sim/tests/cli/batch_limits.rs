@@ -1,0 +1,234 @@
+//! `sim batch`, `sim batch-merge` and `sim bench batch` with bad input: absurd `--jobs` and
+//! batches too large to plan are refused before anything is allocated or spawned, empty sweep
+//! values name their key, and batch-merge refuses to overwrite a shard, to mix shards of
+//! different batches and to merge a batch with shards missing.
+
+use crate::{ROOM, expect_failure, run_ok, sim};
+use std::path::Path;
+
+/// A folder with `tiny.toml` (the 2 s room of the CLI tests) and `other.toml` (the same room
+/// under another name).
+fn room() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let other = ROOM.replace("name = \"tiny\"", "name = \"other\"");
+    std::fs::write(dir.path().join("other.toml"), other).unwrap();
+    dir
+}
+
+/// Runs `sim batch SCENARIO --seeds 0..3 --duration DURATION --shard SHARD --out OUT --quiet`.
+fn shard(dir: &Path, scenario: &str, duration: &str, shard: &str, out: &str) {
+    run_ok(
+        &[
+            "batch",
+            scenario,
+            "--seeds",
+            "0..3",
+            "--duration",
+            duration,
+            "--shard",
+            shard,
+            "--jobs",
+            "1",
+            "--out",
+            out,
+            "--quiet",
+        ],
+        dir,
+    );
+}
+
+#[test]
+fn batch_refuses_absurd_jobs() {
+    let dir = room();
+    expect_failure(
+        &["batch", "tiny.toml", "--seeds", "0..1", "--jobs", "5000"],
+        dir.path(),
+        &["--jobs", "5000 is not in 0..=1024"],
+    );
+}
+
+#[test]
+fn batch_never_starts_more_workers_than_runs() {
+    let dir = room();
+    let out = sim(
+        &[
+            "batch",
+            "tiny.toml",
+            "--seeds",
+            "0..1",
+            "--duration",
+            "0.1",
+            "--jobs",
+            "1024",
+            "--out",
+            "b",
+        ],
+        dir.path(),
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains(": 1 runs, 1 at a time"), "{err}");
+}
+
+#[test]
+fn batch_refuses_too_many_seeds() {
+    let dir = room();
+    expect_failure(
+        &["batch", "tiny.toml", "--seeds", "0..18446744073709551615"],
+        dir.path(),
+        &[
+            "--seeds 0..18446744073709551615 makes 18446744073709551615 runs",
+            "more than the 1000000 a batch may have",
+        ],
+    );
+    assert!(
+        !dir.path()
+            .join("batch-tiny-0-18446744073709551615")
+            .exists()
+    );
+}
+
+#[test]
+fn batch_refuses_sweeps_that_overflow_the_run_count() {
+    let dir = room();
+    expect_failure(
+        &[
+            "batch",
+            "tiny.toml",
+            "--seeds",
+            "0..6148914691236517206",
+            "--sweep",
+            "k=a,b,c",
+        ],
+        dir.path(),
+        &[
+            "--seeds 0..6148914691236517206 × 3 parameter sets (--sweep/--zip) makes 18446744073709551618 runs",
+        ],
+    );
+    expect_failure(
+        &[
+            "batch",
+            "tiny.toml",
+            "--seeds",
+            "0..9223372036854775808",
+            "--sweep",
+            "k=a,b",
+        ],
+        dir.path(),
+        &["× 2 parameter sets (--sweep/--zip) makes 18446744073709551616 runs"],
+    );
+}
+
+#[test]
+fn bench_batch_refuses_too_many_seeds() {
+    let dir = room();
+    expect_failure(
+        &["bench", "batch", "--seeds", "4294967296"],
+        dir.path(),
+        &["--seeds", "4294967296 is not in 1..=1000000"],
+    );
+}
+
+#[test]
+fn bench_batch_help_gives_the_duration_it_uses() {
+    let dir = room();
+    let help = run_ok(&["bench", "batch", "--help"], dir.path());
+    assert!(!help.contains("(default: the scenario"), "{help}");
+    assert!(
+        help.contains("in place of the scenario's own duration"),
+        "{help}"
+    );
+    assert!(help.contains("[default: 30]"), "{help}");
+}
+
+#[test]
+fn empty_sweep_and_zip_values_name_the_key() {
+    let dir = room();
+    for flag in ["--sweep", "--zip"] {
+        for (arg, i) in [("k=", 1), ("k=,", 1), ("k=0.5,", 2)] {
+            let want = format!("{flag} {arg}: value {i} of the list is empty");
+            expect_failure(
+                &["batch", "tiny.toml", "--seeds", "0..1", flag, arg],
+                dir.path(),
+                &[&want],
+            );
+        }
+    }
+}
+
+#[test]
+fn merge_refuses_to_overwrite_a_shard() {
+    let dir = room();
+    shard(dir.path(), "tiny.toml", "0.1", "0/2", "s0");
+    shard(dir.path(), "tiny.toml", "0.1", "1/2", "s1");
+    let before = std::fs::read_to_string(dir.path().join("s0/runs.jsonl")).unwrap();
+    expect_failure(
+        &["batch-merge", "s0", "s0", "s1"],
+        dir.path(),
+        &[
+            "s0: the output folder is also given as a shard",
+            "another folder",
+        ],
+    );
+    // also when the same folder is spelled differently
+    expect_failure(
+        &["batch-merge", "./s1/", "s0", "s1"],
+        dir.path(),
+        &["the output folder is also given as a shard (s1)"],
+    );
+    let after = std::fs::read_to_string(dir.path().join("s0/runs.jsonl")).unwrap();
+    assert_eq!(before, after);
+    // the shards merge into another folder, which is then a whole batch of its own
+    run_ok(&["batch-merge", "m", "s0", "s1", "--quiet"], dir.path());
+    let rows = std::fs::read_to_string(dir.path().join("m/runs.jsonl")).unwrap();
+    assert_eq!(rows.lines().count(), 3);
+    run_ok(&["batch-merge", "m2", "m", "--quiet"], dir.path());
+}
+
+#[test]
+fn merge_refuses_shards_of_different_batches() {
+    let dir = room();
+    shard(dir.path(), "tiny.toml", "0.1", "0/2", "s0");
+    shard(dir.path(), "other.toml", "0.1", "1/2", "o1");
+    shard(dir.path(), "tiny.toml", "0.2", "1/2", "d1");
+    shard(dir.path(), "tiny.toml", "0.1", "1/3", "n1");
+    expect_failure(
+        &["batch-merge", "m", "s0", "o1"],
+        dir.path(),
+        &["s0 and o1 are not shards of the same batch: the scenario is tiny in s0 but other in o1"],
+    );
+    expect_failure(
+        &["batch-merge", "m", "s0", "d1"],
+        dir.path(),
+        &["s0 and d1 are not shards of the same batch: --duration is 0.1 in s0 but 0.2 in d1"],
+    );
+    expect_failure(
+        &["batch-merge", "m", "s0", "n1"],
+        dir.path(),
+        &["the number of shards N (--shard K/N) is 2 in s0 but 3 in n1"],
+    );
+    assert!(!dir.path().join("m").exists());
+}
+
+#[test]
+fn merge_refuses_missing_shards() {
+    let dir = room();
+    shard(dir.path(), "tiny.toml", "0.1", "0/3", "s0");
+    expect_failure(
+        &["batch-merge", "m", "s0"],
+        dir.path(),
+        &[
+            "shards 1/3, 2/3 of the batch are missing",
+            "--shard K/3 for K from 0 to 2",
+        ],
+    );
+    // a folder without batch.json is not taken for a whole batch
+    std::fs::remove_file(dir.path().join("s0/batch.json")).unwrap();
+    expect_failure(
+        &["batch-merge", "m", "s0"],
+        dir.path(),
+        &["batch.json: cannot read"],
+    );
+    assert!(!dir.path().join("m").exists());
+}
