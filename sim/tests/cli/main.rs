@@ -1,5 +1,6 @@
 //! The `sim` command line: exit codes, error messages, default file names, the summary JSON.
 
+mod bounds_match_loc;
 mod carmen;
 mod interrupt;
 mod matching;
