@@ -20,10 +20,17 @@ use serde::Serialize;
 use std::time::Instant;
 use systems::core::Pose2;
 use systems::localization::fixtures::{
-    CORRIDOR, DriveStep, bench_markov_grid, bench_mcl, map_from, recorded_drive,
+    CORRIDOR, DriveStep, SCAN_BEAMS, bench_markov_grid, bench_mcl, map_from, recorded_drive,
 };
 use systems::localization::mcl::{BeamSubset, sensor_model};
 use systems::localization::{LocalizationMap, MarkovGridConfig};
+
+/// Largest `--reps` (timed updates per configuration).
+pub const MAX_REPS: usize = 10_000;
+/// Largest `--particles` count (at 60 beams, 60 million beam evaluations an update).
+pub const MAX_PARTICLES: usize = 1_000_000;
+/// Largest `--beams`: every beam of the recorded scans.
+pub const MAX_BEAMS: usize = SCAN_BEAMS;
 
 pub struct LocBenchOptions {
     pub json: bool,
@@ -117,12 +124,23 @@ fn one_core<R: Send>(f: impl FnOnce() -> R + Send) -> anyhow::Result<R> {
         .install(f))
 }
 
+/// Checks the options before anything is built or printed.
 fn check(o: &LocBenchOptions) -> anyhow::Result<()> {
-    if o.reps == 0 {
-        anyhow::bail!("--reps: expected at least 1, got 0");
+    if !(1..=MAX_REPS).contains(&o.reps) {
+        anyhow::bail!("--reps: expected 1 to {MAX_REPS} updates, got {}", o.reps);
     }
-    if o.beams == 0 {
-        anyhow::bail!("--beams: expected at least 1, got 0");
+    if !(1..=MAX_BEAMS).contains(&o.beams) {
+        anyhow::bail!(
+            "--beams: expected 1 to {MAX_BEAMS} (the beams of the recorded scans), got {}",
+            o.beams
+        );
+    }
+    if let Some(n) = o
+        .particles
+        .iter()
+        .find(|n| !(1..=MAX_PARTICLES).contains(*n))
+    {
+        anyhow::bail!("--particles: expected 1 to {MAX_PARTICLES} particles, got {n}");
     }
     Ok(())
 }
@@ -134,9 +152,6 @@ fn warmup(reps: usize) -> usize {
 
 pub fn run_mcl_bench(o: &LocBenchOptions) -> anyhow::Result<()> {
     check(o)?;
-    if o.particles.contains(&0) {
-        anyhow::bail!("--particles: expected at least 1 particle");
-    }
     let d = hospital_drive(o.beams)?;
     let n_steps = d.steps.len();
     if !o.json {

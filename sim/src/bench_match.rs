@@ -6,7 +6,7 @@
 //! (rand/1, population 20, F 0.5, CR 0.9) for a fixed 1000 generations (no early stop, so its
 //! time is the cost of 20 020 fitness evaluations).
 
-use crate::experiment::de_match::{MAX_XY_M, PERIOD_S, STEPS, thesis_de};
+use crate::experiment::de_match::{MAX_XY_M, PERIOD_S, STEPS, check_pairs, thesis_de};
 use crate::experiment::scan_pairs::{LMS100_BEAMS, bundled, capture, draw_pairs};
 use crate::match_cmd::TransformError;
 use crate::stats::{median, quantile};
@@ -36,9 +36,7 @@ struct BenchRow {
 }
 
 pub fn run_de_match_bench(o: &DeMatchBenchOptions) -> anyhow::Result<()> {
-    if o.pairs == 0 {
-        anyhow::bail!("--pairs: expected at least 1 pair, got 0");
-    }
+    check_pairs(o.pairs)?;
     let sc = bundled("hospital_patrol")?;
     let data = vec![capture(&sc, PERIOD_S, Some(60.0), 0)?];
     let mut rng = stream_rng(0, "bench/de-match", "pairs");

@@ -98,10 +98,10 @@ enum Command {
         #[arg(long, value_enum)]
         crossover: Option<CrossoverArg>,
         /// DE population size (default 100, the thesis program's).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(..=sim::match_cmd::MAX_POPULATION as u64))]
         pop: Option<usize>,
         /// DE generations (default 10000, the thesis program's).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(..=sim::match_cmd::MAX_GENERATIONS as u64))]
         gens: Option<usize>,
         /// DE mutation constant F (default 0.9).
         #[arg(short = 'F', allow_negative_numbers = true)]

@@ -80,6 +80,14 @@ pub fn parse_strategy(text: &str) -> Result<Strategy, String> {
         })
 }
 
+/// Largest `--pop`: a thousand times the thesis program's 100 (each generation evaluates the
+/// whole population).
+pub const MAX_POPULATION: usize = 100_000;
+/// Largest `--gens`: a hundred times the thesis program's 10 000.
+pub const MAX_GENERATIONS: usize = 1_000_000;
+/// Largest `--max-xy` (m): far beyond any laser's range, so beyond any overlap of two scans.
+pub const MAX_WINDOW_XY_M: f64 = 100.0;
+
 /// Options of `sim match`.
 #[derive(Clone, Debug)]
 pub struct MatchOptions {
@@ -105,9 +113,9 @@ pub struct MatchOptions {
 
 /// Builds the matcher configuration of the options (errors name the option).
 pub fn match_config(o: &MatchOptions) -> anyhow::Result<MatchConfig> {
-    if !(o.max_xy.is_finite() && o.max_xy > 0.0) {
+    if !(o.max_xy > 0.0 && o.max_xy <= MAX_WINDOW_XY_M) {
         anyhow::bail!(
-            "--max-xy: expected a positive distance in metres, got {}",
+            "--max-xy: expected a positive distance in metres of at most {MAX_WINDOW_XY_M}, got {}",
             o.max_xy
         );
     }
@@ -176,7 +184,9 @@ pub fn match_config(o: &MatchOptions) -> anyhow::Result<MatchConfig> {
                 if !(t.is_finite() && t > 0.0) {
                     anyhow::bail!("--time: expected a positive number of seconds, got {t}");
                 }
-                de.time_limit = Some(Duration::from_secs_f64(t));
+                de.time_limit = Some(Duration::try_from_secs_f64(t).map_err(|_| {
+                    anyhow::anyhow!("--time: {t:e} seconds is too long for a time limit")
+                })?);
             }
             de.validate()
                 .map_err(|e| anyhow::anyhow!("{}", cli_param_error(e)))?;

@@ -75,6 +75,17 @@ pub const STEPS: [usize; 4] = [5, 10, 20, 30];
 pub const MAX_XY_M: f64 = 3.0;
 /// Pairs of the default protocol (the thesis's mutation study, §6.3).
 pub const DEFAULT_PAIRS: usize = 460;
+/// Largest `--pairs` of the experiment and of `sim bench de-match` (20 times the default; the
+/// points of each pair are held in memory, about 17 KB a pair).
+pub const MAX_PAIRS: usize = 10_000;
+
+/// Checks a `--pairs` count: 1 to [`MAX_PAIRS`].
+pub fn check_pairs(n: usize) -> anyhow::Result<usize> {
+    if !(1..=MAX_PAIRS).contains(&n) {
+        anyhow::bail!("--pairs: expected 1 to {MAX_PAIRS} pairs, got {n}");
+    }
+    Ok(n)
+}
 
 /// One method (row) of the experiment.
 #[derive(Clone, Debug)]
@@ -355,6 +366,9 @@ pub fn run_de_match_experiment(o: &DeMatchOptions) -> anyhow::Result<()> {
 
 /// Runs the experiment and returns its rows (progress and `--list-wrong` go to stderr).
 pub fn de_match_rows(o: &DeMatchOptions) -> anyhow::Result<Vec<Row>> {
+    if let Some(n) = o.pairs {
+        check_pairs(n)?;
+    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(o.threads)
         .build()
@@ -385,9 +399,6 @@ fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<Vec<Row>> {
         ("full", p, 50usize, 5000usize)
     } else {
         let n = o.pairs.unwrap_or(DEFAULT_PAIRS);
-        if n == 0 {
-            anyhow::bail!("--pairs: expected at least 1 pair, got 0");
-        }
         let p = draw_pairs(&data, n, &STEPS, MAX_XY_M, &mut rng)?;
         ("default", p, 1usize, 1000usize)
     };

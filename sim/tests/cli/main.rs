@@ -1,6 +1,7 @@
 //! The `sim` command line: exit codes, error messages, default file names, the summary JSON.
 
 mod batch_limits;
+mod bounds_match_loc;
 mod carmen;
 mod interrupt;
 mod matching;

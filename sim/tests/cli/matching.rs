@@ -321,11 +321,7 @@ fn match_population_below_the_strategy_minimum() {
 fn match_bad_mutation_constant() {
     let dir = tempfile::tempdir().unwrap();
     let args = match_maze(&["--fitness", "euclidean", "-F", "0"]);
-    expect_failure(
-        &refs(&args),
-        dir.path(),
-        &["-F:", "F must be finite and > 0"],
-    );
+    expect_failure(&refs(&args), dir.path(), &["-F:", "F must be in (0, 2]"]);
 }
 
 #[test]

@@ -24,9 +24,12 @@ pub fn map_from(yaml: &Path) -> Result<LocalizationMap, MapError> {
     Ok(LocalizationMap::new(load_map(yaml)?, 2.0))
 }
 
+/// Beams of a [`scan_at`] scan.
+pub const SCAN_BEAMS: usize = 1081;
+
 /// A SICK LMS100-like scan (270°, 0.25°, 20 m) from `pose` with 1 cm noise.
 pub fn scan_at(map: &LocalizationMap, pose: &Pose2, rng: &mut SimRng) -> LaserScan {
-    let n = 1081;
+    let n = SCAN_BEAMS;
     let inc = 0.25f32.to_radians();
     let start = -135f32.to_radians();
     let mut ranges = vec![0.0f32; n];

@@ -17,7 +17,7 @@ pub enum MatchError {
         min: usize,
         strategy: Strategy,
     },
-    #[error("the mutation constant F must be finite and > 0, got {0}")]
+    #[error("the mutation constant F must be in (0, 2], got {0}")]
     InvalidF(f64),
     #[error("the crossover rate CR must be in [0, 1], got {0}")]
     InvalidCr(f64),

@@ -212,6 +212,25 @@ fn same_seed_same_answer() {
     }
 }
 
+/// A search window far larger than the scans (up to 10³⁰ m) costs the improved matcher no more
+/// than the scans' extent: no panic, no huge allocation, and still the right answer.
+#[test]
+fn improved_matcher_survives_a_huge_window() {
+    let (reference, truth) = thesis_example_pair();
+    let a = scan_at(reference, None);
+    let b = scan_at(reference.compose(&truth), None);
+    for max_xy in [100.0, 1e4, 1e8, 1e9, 1e30] {
+        let mut cfg = MatchConfig::improved();
+        cfg.window.max_xy = max_xy;
+        let r = match_scans(&a, &b, &cfg).unwrap();
+        assert!(
+            close(&r.transform, &truth, 0.1, 2f64.to_radians()),
+            "window ±{max_xy} m: found {:?}, truth {truth:?}",
+            r.transform
+        );
+    }
+}
+
 #[test]
 fn empty_or_invalid_scans_are_errors() {
     let pts = vec![[1.0f32, 0.0], [0.0, 1.0]];

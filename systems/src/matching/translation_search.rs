@@ -27,10 +27,34 @@ pub(crate) struct Shift {
     pub score: u32,
 }
 
+/// Largest shift radius (cells) one search scores: the accumulator then holds at most
+/// 4095² counters (32 MB), whatever window the caller asks for.
+pub(crate) const MAX_RADIUS: i32 = 2047;
+
+/// The part of the radius worth scoring: shifts beyond it move every used point of `cells` off
+/// the grid, so they all score 0. At most `radius` (negative counts as 0) and [`MAX_RADIUS`].
+fn useful_radius(grid: &ScoreGrid, cells: &[(i32, i32)], radius: i32) -> i32 {
+    let (w, h) = (grid.geom.w as i64, grid.geom.h as i64);
+    let r = radius.clamp(0, MAX_RADIUS) as i64;
+    let mut need = 0i64;
+    for &(x, y) in cells.iter().take(MAX_POINTS) {
+        let (x, y) = (x as i64, y as i64);
+        // shifts in the window keeping the point inside the grid
+        let (i0, i1) = ((-x).max(-r), (w - 1 - x).min(r));
+        let (k0, k1) = ((-y).max(-r), (h - 1 - y).min(r));
+        if i0 <= i1 && k0 <= k1 {
+            need = need.max(i0.abs().max(i1.abs()).max(k0.abs()).max(k1.abs()));
+        }
+    }
+    need as i32
+}
+
 /// Scores every shift `(i, k) ∈ [−radius, radius]²` (in cells) of `cells` (the grid cells of
 /// the rotated points, possibly outside the grid; at most [`MAX_POINTS`] are used) and appends
 /// to `out` up to `maxima` shifts: the best, then repeatedly the best more than `separation`
-/// cells (Chebyshev) from all chosen ones. Ties go to the first in row-major order.
+/// cells (Chebyshev) from all chosen ones. Ties go to the first in row-major order. Only the
+/// shifts that can score are scored (the radius shrinks to [`useful_radius`], so a huge
+/// `radius` costs no more than the grid's size); returns how many were scored.
 pub(crate) fn best_shifts(
     grid: &ScoreGrid,
     cells: &[(i32, i32)],
@@ -39,24 +63,27 @@ pub(crate) fn best_shifts(
     separation: i32,
     acc: &mut Vec<u16>,
     out: &mut Vec<Shift>,
-) {
+) -> u64 {
+    let radius = useful_radius(grid, cells, radius);
     let side = (2 * radius + 1) as usize;
     acc.clear();
     acc.resize(side * side, 0);
-    let (w, h) = (grid.geom.w as i32, grid.geom.h as i32);
+    let (w, h) = (grid.geom.w as i64, grid.geom.h as i64);
+    let r = radius as i64;
     for &(x, y) in cells.iter().take(MAX_POINTS) {
+        let (x, y) = (x as i64, y as i64);
         // shifts keeping the point inside the grid
-        let i0 = (-radius).max(-x);
-        let i1 = radius.min(w - 1 - x);
-        let k0 = (-radius).max(-y);
-        let k1 = radius.min(h - 1 - y);
+        let i0 = (-r).max(-x);
+        let i1 = r.min(w - 1 - x);
+        let k0 = (-r).max(-y);
+        let k1 = r.min(h - 1 - y);
         if i0 > i1 || k0 > k1 {
             continue;
         }
         let len = (i1 - i0 + 1) as usize;
         for k in k0..=k1 {
             let src = ((y + k) * w + x + i0) as usize;
-            let dst = (k + radius) as usize * side + (i0 + radius) as usize;
+            let dst = (k + r) as usize * side + (i0 + r) as usize;
             let row = &grid.score[src..src + len];
             for (a, &s) in acc[dst..dst + len].iter_mut().zip(row) {
                 *a += s as u16;
@@ -91,6 +118,7 @@ pub(crate) fn best_shifts(
             }
         }
     }
+    (side * side) as u64
 }
 
 #[cfg(test)]
@@ -145,5 +173,35 @@ mod tests {
         );
         assert_eq!(out.len(), 1);
         assert_eq!(out[0].score, 0);
+    }
+
+    #[test]
+    fn a_huge_radius_scores_only_the_shifts_that_can_score() {
+        // the outline test again with the largest radius there is, and points far off the grid
+        // on both sides (i32 extremes): same answer, a small accumulator, no overflow
+        let mut outline = Vec::new();
+        for k in 0..40 {
+            outline.push([2.03, -1.01 + 0.05 * k as f32]);
+            outline.push([2.03 - 0.05 * k as f32, 0.99]);
+        }
+        let grid = ScoreGrid::build(&outline, 0.1, 0.3, 1);
+        let mut current: Vec<(i32, i32)> = outline
+            .iter()
+            .step_by(3)
+            .map(|p| grid.geom.cell_coords([p[0] - 0.7, p[1] + 0.4]))
+            .collect();
+        let (mut acc, mut out) = (Vec::new(), Vec::new());
+        let scored = best_shifts(&grid, &current, 15, 3, 3, &mut acc, &mut out);
+        assert_eq!(scored, 31 * 31);
+        current.extend([(i32::MIN, i32::MAX), (i32::MAX, i32::MIN)]);
+        for radius in [i32::MAX, 1_000_000_000, 100_000] {
+            let (mut acc, mut huge) = (Vec::new(), Vec::new());
+            let scored = best_shifts(&grid, &current, radius, 3, 3, &mut acc, &mut huge);
+            // the points lie within a grid size of the grid
+            let side = (4 * grid.geom.w.max(grid.geom.h) + 1) as u64;
+            assert!(scored <= side * side, "{scored} shifts scored");
+            assert_eq!(acc.len() as u64, scored);
+            assert_eq!(huge[0], out[0], "radius {radius}");
+        }
     }
 }

@@ -182,6 +182,10 @@ pub struct DeParams {
     pub parallel: bool,
 }
 
+/// Largest mutation constant F: DE's range is (0, 2] (Storn and Price 1997); larger steps only
+/// throw the trials out of the search box.
+pub const MAX_F: f64 = 2.0;
+
 impl DeParams {
     /// The defaults of the thesis's program (§6): population 100, 10 000 generations, CR 0.9,
     /// F 0.9, rand/1 (eq. 30), binomial crossover, no early stop.
@@ -231,7 +235,7 @@ impl DeParams {
                 strategy: self.strategy,
             });
         }
-        if !(self.f.is_finite() && self.f > 0.0) {
+        if !(self.f > 0.0 && self.f <= MAX_F) {
             return Err(MatchError::InvalidF(self.f));
         }
         if !(0.0..=1.0).contains(&self.cr) {

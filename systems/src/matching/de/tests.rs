@@ -149,6 +149,20 @@ fn bad_parameters_are_errors() {
     ));
     assert_eq!(
         run(DeParams {
+            f: 2.5,
+            ..base.clone()
+        }),
+        Err(MatchError::InvalidF(2.5))
+    );
+    assert!(
+        run(DeParams {
+            f: 2.0,
+            ..base.clone()
+        })
+        .is_ok()
+    );
+    assert_eq!(
+        run(DeParams {
             cr: 1.5,
             ..base.clone()
         }),

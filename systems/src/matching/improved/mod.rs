@@ -238,7 +238,7 @@ pub(crate) fn match_improved(
                 .cell_coords([c * b[0] - s * b[1], s * b[0] + c * b[1]])
         }));
         shifts.clear();
-        best_shifts(
+        evaluations += best_shifts(
             &score_grid,
             &cells,
             radius,
@@ -247,7 +247,6 @@ pub(crate) fn match_improved(
             &mut acc,
             &mut shifts,
         );
-        evaluations += ((2 * radius + 1) * (2 * radius + 1)) as u64;
         for sh in &shifts {
             let t = [sh.i as f64 * cell, sh.k as f64 * cell, theta];
             if bounds.contains(&t) {
