@@ -77,6 +77,15 @@ pub fn run_record_bench(o: &RecordBenchOptions) -> anyhow::Result<Vec<RecordBenc
     if o.reps == 0 {
         anyhow::bail!("--reps: expected at least 1");
     }
+    // every scenario and duration is checked before the table's header and the first run
+    let mut scenarios = Vec::with_capacity(o.scenarios.len());
+    for name in &o.scenarios {
+        let mut sc = scenario_arg(Some(name))?;
+        if let Some(d) = o.duration.or_else(|| default_duration(&sc.name)) {
+            sc.duration = check_duration(d)?;
+        }
+        scenarios.push(sc);
+    }
     let dir = std::env::temp_dir().join(format!("sim-bench-record-{}", std::process::id()));
     std::fs::create_dir_all(&dir)
         .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
@@ -88,11 +97,7 @@ pub fn run_record_bench(o: &RecordBenchOptions) -> anyhow::Result<Vec<RecordBenc
             "scenario", "mode", "sim s", "wall s", "overhead", "rrd MB", "mcap MB", "messages"
         );
     }
-    for name in &o.scenarios {
-        let mut sc = scenario_arg(Some(name))?;
-        if let Some(d) = o.duration.or_else(|| default_duration(&sc.name)) {
-            sc.duration = check_duration(d)?;
-        }
+    for sc in &scenarios {
         let mut times = vec![Vec::new(); MODES.len()];
         let mut last = vec![(0.0, 0, 0, 0); MODES.len()];
         for _ in 0..o.reps {
@@ -105,7 +110,7 @@ pub fn run_record_bench(o: &RecordBenchOptions) -> anyhow::Result<Vec<RecordBenc
                 let _ = std::fs::remove_file(&mcap_path);
                 let started = Instant::now();
                 let out = run_scenario_exporting(
-                    &sc,
+                    sc,
                     &RunOptions {
                         rrd: rrd.then(|| rrd_path.clone()),
                         threads: o.threads,

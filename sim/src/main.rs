@@ -252,7 +252,7 @@ enum ExperimentCommand {
         #[arg(long)]
         json: bool,
         /// With --json: also print every run.
-        #[arg(long)]
+        #[arg(long, requires = "json")]
         per_run: bool,
         /// Routes (bundled scenario names or paths; each once).
         #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = sim::experiment::park::ROUTES.map(String::from))]

@@ -90,6 +90,30 @@ fn park_refuses_absurd_run_counts_and_repeated_routes() {
 }
 
 #[test]
+fn park_per_run_needs_json() {
+    let dir = tempfile::tempdir().unwrap();
+    expect_failure(
+        &["experiment", "park", "--runs", "1", "--per-run"],
+        dir.path(),
+        &["--per-run", "--json"],
+    );
+}
+
+/// A bad scenario or duration stops `bench record` before its table's header is printed.
+#[test]
+fn bench_record_checks_its_options_before_printing() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["bench", "record", "--duration", "-1"][..],
+        &["bench", "record", "--scenario", "hospital_patrol,nowhere"],
+    ] {
+        let out = sim(args, dir.path());
+        assert!(!out.status.success(), "{args:?} should fail");
+        assert!(out.stdout.is_empty(), "{args:?} printed: {:?}", out.stdout);
+    }
+}
+
+#[test]
 fn bench_slam_refuses_long_durations_and_unknown_modes_naming_its_own_options() {
     let dir = tempfile::tempdir().unwrap();
     for d in ["700", "1e12"] {
