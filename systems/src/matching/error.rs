@@ -27,6 +27,16 @@ pub enum MatchError {
     BudgetTooSmall { budget: u64, population: usize },
     #[error("search bounds of axis {axis} are invalid: [{lo}, {hi}] (need finite lo <= hi)")]
     InvalidBounds { axis: usize, lo: f64, hi: f64 },
+    #[error(
+        "the reference scan's points span {width_m:.0} × {height_m:.0} m, more than the matcher's \
+         grids of at most 64 Mi cells of {cell_m} m cover (readings far beyond the laser's real \
+         range?)"
+    )]
+    ReferenceTooWide {
+        width_m: f32,
+        height_m: f32,
+        cell_m: f32,
+    },
     #[error("parameter `{name}` = {value} is invalid: expected {expected}")]
     InvalidParameter {
         name: &'static str,

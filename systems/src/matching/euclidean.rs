@@ -26,6 +26,7 @@
 
 use super::de::Vector;
 use super::error::MatchError;
+use super::ref_grid::MAX_GRID_CELLS;
 
 /// §7.1: `Σ_{a ∈ reference} min_{b ∈ current} ‖a − (R(ω) b + t)‖`, brute force. Non-finite
 /// points are skipped; returns +∞ if either set has no finite point.
@@ -114,14 +115,13 @@ impl EuclideanField {
         let origin = [lo[0] - truncation - cell, lo[1] - truncation - cell];
         let w = ((hi[0] - origin[0] + truncation) / cell).ceil() as usize + 2;
         let h = ((hi[1] - origin[1] + truncation) / cell).ceil() as usize + 2;
-        let cells =
-            w.checked_mul(h)
-                .filter(|&n| n <= 64 << 20)
-                .ok_or(MatchError::InvalidParameter {
-                    name: "field.cell",
-                    value: cell as f64,
-                    expected: "a cell size giving at most 64 Mi cells over the reference scan",
-                })?;
+        let cells = w.checked_mul(h).filter(|&n| n <= MAX_GRID_CELLS).ok_or(
+            MatchError::InvalidParameter {
+                name: "field.cell",
+                value: cell as f64,
+                expected: "a cell size giving at most 64 Mi cells over the reference scan",
+            },
+        )?;
         let mut dist = vec![truncation; cells];
         let inv_cell = 1.0 / cell;
         let reach = (truncation * inv_cell).ceil() as i64 + 1;

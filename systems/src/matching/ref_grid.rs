@@ -15,6 +15,8 @@
 //!   Two bytes a cell, and no distance array (a stamp recomputes the distance to the stored
 //!   point), so a 40 m × 40 m scan at 0.1 m costs 320 KB.
 
+use super::error::MatchError;
+
 /// Marks a cell of [`NearestGrid`] with no reference point within the radius.
 pub(crate) const NONE: u16 = u16::MAX;
 
@@ -22,6 +24,9 @@ pub(crate) const NONE: u16 = u16::MAX;
 pub(crate) const MAX_INDEXED: usize = NONE as usize;
 
 /// Placement of a square grid over a point set.
+/// The most cells a matcher's grid over one reference scan may have (64 Mi).
+pub(crate) const MAX_GRID_CELLS: usize = 64 << 20;
+
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct GridGeom {
     /// World position of the corner of cell (0, 0).
@@ -33,6 +38,25 @@ pub(crate) struct GridGeom {
 }
 
 impl GridGeom {
+    /// Refuses a grid of `cell` over `points` (plus `margin`) with more than
+    /// [`MAX_GRID_CELLS`] cells, before [`ScoreGrid::build`] or [`NearestGrid::build`]
+    /// allocates it.
+    pub(crate) fn check_size(
+        points: &[[f32; 2]],
+        cell: f32,
+        margin: f32,
+    ) -> Result<(), MatchError> {
+        let g = GridGeom::covering(points, cell, margin);
+        match g.w.checked_mul(g.h) {
+            Some(n) if n <= MAX_GRID_CELLS => Ok(()),
+            _ => Err(MatchError::ReferenceTooWide {
+                width_m: g.w as f32 * cell,
+                height_m: g.h as f32 * cell,
+                cell_m: cell,
+            }),
+        }
+    }
+
     /// Covers the bounding box of `points` (finite, non-empty) plus `margin` and a cell.
     fn covering(points: &[[f32; 2]], cell: f32, margin: f32) -> GridGeom {
         let (mut lo, mut hi) = ([f32::INFINITY; 2], [f32::NEG_INFINITY; 2]);

@@ -231,6 +231,29 @@ fn improved_matcher_survives_a_huge_window() {
     }
 }
 
+/// A reference scan with a point 10⁸ m away would need grids of petabytes: every matcher
+/// refuses it with an error instead of aborting on the allocation.
+#[test]
+fn an_absurdly_wide_reference_is_an_error() {
+    let (reference, truth) = thesis_example_pair();
+    let mut a = scan_at(reference, None);
+    let b = scan_at(reference.compose(&truth), None);
+    a.push([1e8, 0.0]);
+    for cfg in [
+        MatchConfig::improved(),
+        MatchConfig::thesis_final_experiment(ThesisFitness::EuclideanField),
+    ] {
+        let e = match_scans(&a, &b, &cfg).expect_err("a 10⁸ m wide reference");
+        assert!(
+            matches!(
+                e,
+                MatchError::ReferenceTooWide { .. } | MatchError::InvalidParameter { .. }
+            ),
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn empty_or_invalid_scans_are_errors() {
     let pts = vec![[1.0f32, 0.0], [0.0, 1.0]];

@@ -74,7 +74,7 @@ use super::judge::{Judge, RUN_GAP};
 use super::movable::{Movable, without_movable};
 use super::normals::estimate_normals;
 use super::orientation::{orientation_histogram, rotation_hypotheses};
-use super::ref_grid::{MAX_INDEXED, NearestGrid, ScoreGrid};
+use super::ref_grid::{GridGeom, MAX_INDEXED, NearestGrid, ScoreGrid};
 use super::refine::{Reference, RefineParams, refine};
 use super::subsample::subsample;
 use super::translation_search::{Shift, best_shifts};
@@ -189,7 +189,9 @@ pub(crate) fn match_improved(
     let ref_coarse = subsample(reference, cfg.coarse_spacing, cfg.coarse_points);
     let ref_normals = estimate_normals(&ref_fine, normal_gate, normal_max_gate);
     let cur_normals = estimate_normals(&cur_fine, normal_gate, normal_max_gate);
-    // 2. reference model
+    // 2. reference model (its grids refused, not allocated, if the scan is absurdly wide)
+    GridGeom::check_size(&ref_fine, cfg.coarse_cell, cfg.coarse_radius)?;
+    GridGeom::check_size(&ref_fine, cfg.fine_cell, cfg.gate)?;
     let score_grid = ScoreGrid::build(&ref_fine, cfg.coarse_cell, cfg.coarse_radius, 2);
     let nearest = NearestGrid::build(&ref_fine, cfg.fine_cell, cfg.gate, 3);
     let judge = Judge {
