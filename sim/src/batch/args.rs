@@ -38,7 +38,7 @@ pub struct BatchArgs {
           value_parser = RangedU64ValueParser::<usize>::new().range(0..=MAX_WORKERS))]
     pub jobs: usize,
     /// Kernel threads of each run (0 = one per core). Results do not depend on it.
-    #[arg(long, default_value_t = 1, value_parser = crate::run_cmd::parse_threads)]
+    #[arg(long, default_value_t = 1, value_parser = crate::options::parse_threads)]
     pub threads: usize,
     /// Output folder (default: batch-<scenario>-<A>-<B>, plus -shard<k>of<n> with --shard).
     #[arg(long)]

@@ -15,15 +15,14 @@ pub mod output;
 pub mod params;
 pub mod runner;
 pub mod sets;
-#[cfg(test)]
-mod tests_params;
 
 pub use args::BatchArgs;
 
-use crate::run_cmd::{check_duration, scenario_path};
-use crate::runner::{RunOptions, run_scenario};
+use crate::options::check_duration;
+use crate::scenario::scenario_path;
+use crate::run::{RunOptions, run_scenario};
 use crate::scenario::Scenario;
-use crate::summary::Summary;
+use crate::run::summary::Summary;
 use output::Row;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -5,7 +5,7 @@
 //! appearance) and `runs.jsonl` (one object per line, keys in the same order).
 
 use super::params::Override;
-use crate::summary::Summary;
+use crate::run::summary::Summary;
 use serde_json::{Map, Value as Json, json};
 use std::io::Write;
 use std::path::Path;

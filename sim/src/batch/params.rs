@@ -294,3 +294,6 @@ pub fn blame<'a>(overrides: &'a [(Override, String)], error_key: &str) -> Vec<&'
         .map(|(o, _)| o)
         .collect()
 }
+
+#[cfg(test)]
+mod tests;

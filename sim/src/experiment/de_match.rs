@@ -1,4 +1,4 @@
-//! `sim experiment de-match`: the scan-matching experiments of 000_9f0113837c153763.txt (§6.3,
+//! `sim experiment de-match`: the scan-matching experiments of [Hospital thesis] (§6.3,
 //! the mutation study on N = 460 pairs, table 2; §7.2–7.3, the final comparison with the
 //! Euclidean reference, tables 3–4) on scans captured in-process from the bundled maze and
 //! hospital scenarios, plus our improved matcher.
@@ -33,8 +33,8 @@
 use super::scan_pairs::{
     LMS100_BEAMS, Pair, ScenarioScans, bundled, capture, draw_pairs, draw_reference_sets,
 };
-use crate::match_cmd::{THESIS_CORRELATION_FILTER, TransformError, strategy_cli_name};
-use crate::scans::write_scans;
+use crate::experiment::match_pair::{THESIS_CORRELATION_FILTER, TransformError, strategy_cli_name};
+use crate::formats::scans::write_scans;
 use crate::stats::{median, quantile};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -48,20 +48,38 @@ use systems::matching::{
 };
 
 /// Options of `sim experiment de-match`.
-#[derive(Clone, Debug, Default)]
+/// Options of `sim experiment de-match`.
+#[derive(clap::Args, Clone, Debug, Default)]
 pub struct DeMatchOptions {
+    /// One JSON object per row, one per line.
+    #[arg(long)]
     pub json: bool,
+    /// The thesis's full protocol: 80 reference scans × steps 5, 10, 20, 30 × 50 repeats,
+    /// up to 5000 generations (hours).
+    #[arg(long)]
     pub full: bool,
+    /// Worker threads for the pairs (0 = one per core; at most 1024). Results do not
+    /// depend on it.
+    #[arg(long, default_value_t = 0, value_parser = crate::options::parse_threads)]
     pub threads: usize,
+    /// Seed of the pair selection and of the matchers.
+    #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Pairs of the default protocol (default 460).
+    /// Pairs of the default protocol (default 460; a small number for quick checks).
+    #[arg(long, hide = true, conflicts_with = "full")]
     pub pairs: Option<usize>,
     /// Pairs on which the brute-force Euclidean reference runs.
+    #[arg(long, default_value_t = 50)]
     pub brute_pairs: usize,
+    /// Write the captured scans of both scenarios to this folder (maze_run.csv,
+    /// hospital_patrol.csv), for `sim match`.
+    #[arg(long)]
     pub save_scans: Option<PathBuf>,
-    /// Only the methods whose name contains this.
+    /// Only the methods whose name contains this text (e.g. `improved`, `rand/1`).
+    #[arg(long)]
     pub only: Option<String>,
-    /// Print every wrong alignment to stderr.
+    /// Print every wrong alignment (scan indices, truth, answer) to stderr.
+    #[arg(long)]
     pub list_wrong: bool,
 }
 
@@ -350,7 +368,7 @@ pub fn run_de_match_experiment(o: &DeMatchOptions) -> anyhow::Result<()> {
     let rows = de_match_rows(o)?;
     if o.json {
         for r in &rows {
-            println!("{}", crate::machine::json_line(r)?);
+            println!("{}", crate::bench::machine::json_line(r)?);
         }
     } else {
         print!("{}", table(&rows));

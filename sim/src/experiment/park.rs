@@ -1,5 +1,4 @@
-//! `sim experiment park`: the park runs of 004_95e533f2514531b8.txt (SEEDS.md, "Experiments":
-//! the 350 m route, where the thesis's car took a wrong turn in 2 of 3 runs one way and
+//! `sim experiment park`: the park runs of [Park thesis] (its experiments: the 350 m route, where the thesis's car took a wrong turn in 2 of 3 runs one way and
 //! recovered by re-localization and re-planning, and the 190 m route that avoids a U-turn, all
 //! runs reaching the goal). Each route runs N times with seeds 0..N, once navigating by the
 //! thesis's road-grid localization and once by the road MCL; both localizers run in every run,
@@ -9,7 +8,7 @@
 use super::scan_pairs::bundled;
 use crate::scenario::Scenario;
 use crate::scenario::outdoor_robot::RoadLocalizerKind;
-use crate::summary_road::RoadSummary;
+use crate::run::summary::road::RoadSummary;
 use crate::{RunOptions, run_scenario};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -17,12 +16,20 @@ use serde::Serialize;
 /// The routes of the experiment (bundled scenarios).
 pub const ROUTES: [&str; 2] = ["park_route_long", "park_route_short"];
 
-#[derive(Clone, Debug)]
+/// `sim experiment park`.
+#[derive(clap::Args, Clone, Debug)]
 pub struct ParkOptions {
+    /// Routes (bundled scenario names or paths; each once).
+    #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = ROUTES.map(String::from))]
     pub routes: Vec<String>,
+    /// Runs per route and localizer (at most 100000).
+    #[arg(long, default_value_t = 20)]
     pub runs: u64,
-    /// Worker threads (0 = one per core).
+    /// Worker threads (0 = one per core; at most 1024). Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = crate::options::parse_threads)]
     pub threads: usize,
+    /// Print progress to stderr (not a flag: on unless `--json`).
+    #[arg(skip)]
     pub progress: bool,
 }
 
@@ -184,7 +191,7 @@ fn row(route: &str, by: &str, seeds: u64, runs: &[&ParkRun]) -> ParkRow {
         .filter_map(|r| r.road.arrival_time_s)
         .collect();
     let loc =
-        |name: &str, f: &dyn Fn(&crate::summary_road::RoadLocalizerSummary) -> Option<f64>| {
+        |name: &str, f: &dyn Fn(&crate::run::summary::road::RoadLocalizerSummary) -> Option<f64>| {
             mean(
                 runs.iter()
                     .filter_map(|r| r.road.localizers.get(name))

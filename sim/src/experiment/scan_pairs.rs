@@ -1,10 +1,10 @@
 //! Scan pairs for the scan-matching experiment and benchmark, after the protocol of
-//! 000_9f0113837c153763.txt §7.2: scans captured in-process from a bundled scenario at a fixed
+//! [Hospital thesis §7.2]: scans captured in-process from a bundled scenario at a fixed
 //! period (a "step" is one scan of one robot), a random reference scan and a test scan a given
 //! number of steps later on the same robot's stream.
 
-use crate::runner::ScanCapture;
-use crate::scans::{ScanRecord, capture_scans};
+use crate::formats::scans::ScanRecord;
+use crate::run::{ScanCapture, capture_scans};
 use crate::scenario::{Scenario, find_scenario, load_scenario};
 use rand::RngExt;
 use systems::core::{Pose2, SimRng};

@@ -1,13 +1,12 @@
-//! `sim experiment maze-slam`: the maze run of 000_9f0113837c153763.txt (SEEDS.md, "Maze SLAM
-//! experiment": poses from consecutive scan pairs drift by integration; the fix proposed is to
-//! match each scan against the map built so far) and the hospital loop, with every method of
-//! issue 5 on identical data:
+//! `sim experiment maze-slam`: the maze run of [Hospital thesis] (poses from consecutive scan pairs drift by integration; the fix proposed is to
+//! match each scan against the map built so far) and the hospital loop, with every odometry and SLAM
+//! method we have on identical data:
 //!
 //! * `wheel_odometry` — the encoders alone;
 //! * `de_scan_to_scan` — differential-evolution scan-to-scan odometry (the thesis's method,
 //!   [`systems::localization::de_odometry`]);
 //! * `scan_to_map_de` — scan_to_map with the DE matcher instead of Gauss-Newton;
-//! * `scan_to_map`, `rbpf`, `graph` — the three SLAM families 001_6ab7973871dfdca6.txt compares
+//! * `scan_to_map`, `rbpf`, `graph` — the three SLAM families [SLAM thesis] compares
 //!   (Hector-style, GMapping-style, Cartographer-style), with their default settings.
 //!
 //! Each scenario is simulated once and exported as a CARMEN log (as `sim run --carmen-out`);
@@ -21,11 +20,11 @@
 
 use super::scan_pairs::bundled;
 use crate::build::new_scan_estimator;
-use crate::carmen::{CarmenReadOptions, ScanRecord, read_carmen};
+use crate::formats::carmen::{CarmenReadOptions, ScanRecord, read_carmen};
 use crate::scenario::Scenario;
 use crate::scenario::slam_file::resolve_slam_config;
-use crate::slam_cmd::eval::TruthTrack;
-use crate::slam_cmd::feed::feed_scans;
+use crate::log_slam::eval::TruthTrack;
+use crate::log_slam::feed::feed_scans;
 use crate::{RunExports, RunOptions, run_scenario_exporting};
 use serde::Serialize;
 use systems::core::{KernelPool, Pose2, stream_rng};
@@ -50,14 +49,20 @@ pub const METHODS: [&str; 6] = [
     "graph",
 ];
 
-#[derive(Clone, Debug)]
+/// `sim experiment maze-slam`.
+#[derive(clap::Args, Clone, Debug)]
 pub struct SlamExperimentOptions {
-    /// Scenario names (bundled) or paths.
+    /// Scenarios: bundled names or paths.
+    #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = SCENARIOS.map(String::from))]
     pub scenarios: Vec<String>,
+    /// Methods to run.
+    #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = METHODS.map(String::from))]
     pub methods: Vec<String>,
-    /// Kernel threads (0 = one per core); results do not depend on it.
+    /// Kernel threads (0 = one per core; at most 1024). Results do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = crate::options::parse_threads)]
     pub threads: usize,
-    /// Print progress to stderr.
+    /// Print progress to stderr (not a flag: on unless `--json`).
+    #[arg(skip)]
     pub progress: bool,
 }
 
@@ -112,7 +117,7 @@ pub fn run_slam_experiment(o: &SlamExperimentOptions) -> anyhow::Result<Vec<Slam
             true => crate::load_scenario(std::path::Path::new(name))?,
             false => bundled(name)?,
         };
-        if crate::carmen_out::exported_robots(&scenario).is_empty() {
+        if crate::formats::carmen::export::exported_robots(&scenario).is_empty() {
             anyhow::bail!(
                 "--scenarios: {name}: no robot with a laser and wheel encoders (the methods run \
                  on its laser scans and odometry)"
@@ -135,7 +140,7 @@ pub fn run_slam_experiment(o: &SlamExperimentOptions) -> anyhow::Result<Vec<Slam
 pub fn simulate(
     scenario: &Scenario,
     o: &SlamExperimentOptions,
-) -> anyhow::Result<crate::carmen::CarmenLog> {
+) -> anyhow::Result<crate::formats::carmen::CarmenLog> {
     let dir = std::env::temp_dir().join(format!(
         "sim-slam-experiment-{}-{}",
         std::process::id(),
@@ -170,7 +175,7 @@ pub fn simulate(
 /// Runs and judges every method on `log`.
 pub fn judge_methods(
     scenario: &Scenario,
-    log: &crate::carmen::CarmenLog,
+    log: &crate::formats::carmen::CarmenLog,
     methods: &[String],
     pool: &KernelPool,
     progress: bool,

@@ -1,22 +1,13 @@
-//! Recording: the Rerun .rrd file (always, unless disabled), on request TUM trajectories of
-//! every localizer, and the MCAP layer of ROS 2 replays ([`mcap`]: messages, schemas, CDR,
-//! writer and reader; the replay's topics are in `crate::mcap_out`). The recording's threads
-//! run at background priority ([`priority`]).
+//! Recording: the Rerun .rrd file ([`rrd`], always unless disabled), the MCAP layer of ROS 2
+//! replays ([`mcap`]: messages, schemas, CDR, writer and reader) and the run's topics in it
+//! ([`topics`]), the camera frames both share ([`frames`]). The recording's threads run at
+//! background priority ([`priority`]).
 
-pub mod belief;
 pub mod frames;
 pub mod mcap;
-pub mod navigation;
-pub mod outdoor;
-pub mod path_trace;
 pub mod priority;
-pub mod replay;
-pub mod rows;
 pub mod rrd;
-pub mod slam;
-pub mod stream;
-pub mod tum;
+pub mod topics;
 
-pub use navigation::record_navigation;
+pub use rrd::navigation::record_navigation;
 pub use rrd::{RrdRecorder, record_rrd};
-pub use tum::write_trajectories;

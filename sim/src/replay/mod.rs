@@ -1,5 +1,5 @@
 //! `sim replay FILE.mcap`: re-runs localization, SLAM and evaluation on recorded sensor data,
-//! without physics, sensors, control or navigation (DESIGN.md, "Formats to speak": replays).
+//! without physics, sensors, control or navigation (the replay format of `sim/docs/recordings.md`).
 //!
 //! The world is built from the scenario as for a live run, with only the estimators' and the
 //! evaluation's systems ([`crate::build::BuildMode::Replay`]); a feed system in the Sense set
@@ -32,9 +32,9 @@ pub use source::{RobotFeed, TopicFlags};
 
 use crate::build::{BuildMode, build_world_with};
 use crate::record::mcap::McapRecording;
-use crate::run_cmd::{OutputArgs, report_run};
-use crate::run_exports::RunExports;
-use crate::runner::{RunOptions, RunOutput, run_built};
+use crate::run::report::{OutputArgs, report_run};
+use crate::run::exports::RunExports;
+use crate::run::{RunOptions, RunOutput, run_built};
 use bevy_ecs::prelude::*;
 use feed::FedRobot;
 use std::path::PathBuf;

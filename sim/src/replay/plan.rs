@@ -5,9 +5,9 @@
 use super::ReplayArgs;
 use super::source::{RobotFeed, TimeBase, TopicFlags, first_stamp, robot_feed};
 use crate::batch::sets::{Source, plan_sets};
-use crate::mcap_out::RunInfo;
+use crate::record::topics::RunInfo;
 use crate::record::mcap::McapRecording;
-use crate::run_cmd::scenario_path;
+use crate::scenario::scenario_path;
 use crate::scenario::{Scenario, assets_dir};
 use anyhow::{anyhow, bail};
 use std::path::{Path, PathBuf};

@@ -3,8 +3,8 @@
 //! and the true pose. Our own files carry exact times ([`crate::record::mcap::time_on_grid`]
 //! with the periods of `run.json`); a foreign file's header stamps count from its first stamp.
 
-use crate::mcap_out::RunInfo;
-use crate::mcap_out::{ACKERMANN_JOINTS, DIFF_DRIVE_JOINTS, ticks_of_angle};
+use crate::record::topics::RunInfo;
+use crate::record::topics::{ACKERMANN_JOINTS, DIFF_DRIVE_JOINTS, ticks_of_angle};
 use crate::record::mcap::messages::{
     Header, JointState, LaserScan as ScanMsg, Odometry, Pose, PoseStamped,
 };

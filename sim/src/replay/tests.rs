@@ -5,7 +5,7 @@
 use super::*;
 use crate::record::mcap::messages::{LaserScan, Odometry, PoseStamped};
 use crate::record::mcap::{McapRecorder, ROS2_PROFILE};
-use crate::runner::{RobotLocalization, run_scenario_exporting};
+use crate::run::{RobotLocalization, run_scenario_exporting};
 use crate::scenario::assets_dir;
 use std::path::Path;
 
@@ -35,7 +35,7 @@ fn live_with(name: &str, sets: &[&str], duration: f64, mcap: &Path) -> RunOutput
 fn args(file: &Path, extra: &[&str]) -> ReplayArgs {
     let mut v = vec![file.to_str().unwrap()];
     v.extend_from_slice(extra);
-    crate::run_cmd::parse_args::<ReplayArgs>(&v).unwrap()
+    crate::options::parse_args::<ReplayArgs>(&v).unwrap()
 }
 
 fn replay_file(a: &ReplayArgs) -> anyhow::Result<RunOutput> {

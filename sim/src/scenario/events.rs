@@ -1,12 +1,55 @@
 //! `[[events]]`: timed scenario events (routes, kidnapping, sensor faults, doors), checked
 //! against the robots, doors and map they concern.
 
+use serde::Deserialize;
 use super::error::KeyPath;
-use super::file::{EventFile, EventType, PointOrPlace, SensorName};
-use super::resolve::{Checker, R};
+use super::check::PointOrPlace;
+use super::check::{Checker, R};
 use super::{DoorConfig, Event, EventAction, RobotConfig};
 use systems::core::Pose2;
 use systems::world::OccupancyGrid;
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum EventType {
+    Waypoints,
+    #[serde(alias = "kidnap")]
+    Teleport,
+    SensorFault,
+    Door,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorName {
+    Laser,
+    Encoder,
+    Sonar,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct EventFile {
+    /// Simulated time (s).
+    pub at: f64,
+    #[serde(rename = "type")]
+    pub kind: EventType,
+    /// The robot (every event but `door`).
+    pub robot: Option<String>,
+    // waypoints
+    pub points: Option<Vec<PointOrPlace>>,
+    #[serde(rename = "loop")]
+    pub looping: Option<bool>,
+    // teleport
+    pub pose: Option<PointOrPlace>,
+    // sensor_fault
+    pub sensor: Option<SensorName>,
+    /// true: the fault starts (sensor silent); false: it ends.
+    pub active: Option<bool>,
+    // door
+    pub door: Option<String>,
+    pub open: Option<bool>,
+}
 
 /// Resolves a `points` key (a list of [x, y] or place names).
 type PointList<'a> = dyn Fn(&KeyPath, &Option<Vec<PointOrPlace>>) -> R<Vec<[f64; 2]>> + 'a;

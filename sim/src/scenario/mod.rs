@@ -1,8 +1,9 @@
 //! Scenario files (TOML): seed, dt, duration, the world (ROS map and/or vector shapes, named
 //! places), robots (kinematics, footprint, start pose, sensors from presets with overrides, a
 //! driving behaviour), recording rates and timed events. Unknown keys and out-of-range values are
-//! errors naming the file, line and key. The format is documented in README.md.
+//! errors naming the file, line and key. The format is documented in `sim/docs/scenario-format.md`.
 
+pub mod check;
 pub mod error;
 pub mod events;
 pub mod file;
@@ -19,7 +20,7 @@ pub mod slam_file;
 pub mod sonar;
 
 pub use error::ScenarioError;
-pub use file::SensorName;
+pub use events::SensorName;
 pub use localizers::{LocalizerConfig, LocalizerKind};
 pub use navigation::NavConfig;
 pub use people::PersonConfig;
@@ -225,4 +226,15 @@ pub fn find_scenario(arg: &str) -> anyhow::Result<PathBuf> {
         "{arg}: no such file and no bundled scenario of that name (bundled: {})",
         names.join(", ")
     )
+}
+
+/// A scenario file or the name of a bundled scenario (default: hospital_patrol).
+pub fn scenario_arg(arg: Option<&str>) -> anyhow::Result<Scenario> {
+    Ok(load_scenario(&scenario_path(arg)?)?)
+}
+
+/// The file of a scenario argument: a path, or the name of a bundled scenario (default:
+/// hospital_patrol).
+pub fn scenario_path(arg: Option<&str>) -> anyhow::Result<PathBuf> {
+    find_scenario(arg.unwrap_or(DEFAULT_SCENARIO))
 }

@@ -2,15 +2,59 @@
 //! task queue. Places in tasks resolve through the map's places file; every value is checked
 //! with the robot and key named in the error.
 
+use serde::Deserialize;
 use super::LocalizerConfig;
 use super::error::KeyPath;
-use super::file::{NavigationFile, PointOrPlace, TaskFile, TaskType};
-use super::resolve::{Checker, R};
+use super::check::PointOrPlace;
+use super::check::{Checker, R};
 use systems::body::{Footprint, Kinematics};
 use systems::core::Pose2;
 use systems::navigation::{
     CostmapParams, FollowerParams, Goal, NavParams, PlannerParams, Steering, Task, TaskKind,
 };
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct NavigationFile {
+    /// Name of the localizer to navigate by (default: wheel odometry).
+    pub localizer: Option<String>,
+    pub speed: Option<f64>,
+    pub max_accel: Option<f64>,
+    pub max_yaw_rate: Option<f64>,
+    pub tolerance: Option<f64>,
+    pub lookahead: Option<f64>,
+    /// Added to the robot radius for the costmap's impassable band (m).
+    pub safety_margin: Option<f64>,
+    pub inflation_radius: Option<f64>,
+    pub cost_weight: Option<f64>,
+    pub stop_distance: Option<f64>,
+    pub wait_time: Option<f64>,
+    pub priority: Option<u32>,
+}
+
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+pub enum TaskType {
+    Delivery,
+    Go,
+    Wait,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct TaskFile {
+    #[serde(rename = "type")]
+    pub kind: TaskType,
+    pub name: Option<String>,
+    pub from: Option<PointOrPlace>,
+    pub to: Option<PointOrPlace>,
+    /// Loading time at `from` (s).
+    pub load: Option<f64>,
+    /// Unloading time at `to` (s).
+    pub unload: Option<f64>,
+    /// Waiting time of a `wait` task (s).
+    pub time: Option<f64>,
+}
 
 /// A robot's navigation, resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -231,7 +275,7 @@ fn resolve_task(
         }
     };
     let name = match &t.name {
-        Some(n) if super::resolve::check_name(n) => n.clone(),
+        Some(n) if super::check::check_name(n) => n.clone(),
         Some(n) => {
             return c.err(
                 &p.key("name"),

@@ -1,11 +1,11 @@
 //! The outdoor world of a scenario: `[roads]` (a road network from OSM XML or GPX 1.1, projected
 //! to local metres around a reference point) and `[[zones]]` (areas that degrade GPS and compass
 //! readings: open sky, trees, buildings, electromagnetic interference), as in the park runs of
-//! 004_95e533f2514531b8.txt. Errors name the file, line and key; a road file's own errors keep
+//! [Park thesis]. Errors name the file, line and key; a road file's own errors keep
 //! their file:line:column.
 
 use super::error::KeyPath;
-use super::resolve::{Checker, R, check_name};
+use super::check::{Checker, R, check_name};
 use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;

@@ -1,12 +1,12 @@
 //! A robot's outdoor parts: `[robots.sensors.gps]`, `[robots.sensors.compass]`,
-//! `[robots.sensors.camera]`, the `thesis_car` preset (the RC car of 004_95e533f2514531b8.txt,
-//! SEEDS.md: 520 × 400 mm, Ackermann steering, one drive-shaft encoder with under 1 % distance
+//! `[robots.sensors.camera]`, the `thesis_car` preset (the RC car of [Park thesis]:
+//! 520 × 400 mm, Ackermann steering, one drive-shaft encoder with under 1 % distance
 //! error, four SRF02 sonars, GPS, compass and camera) and `[robots.route]` (drive to a node of
 //! the road network, localizing on the roads).
 
 use super::error::KeyPath;
 use super::outdoor::RoadsConfig;
-use super::resolve::{Checker, R};
+use super::check::{Checker, R};
 use serde::Deserialize;
 use systems::body::{Ackermann, Footprint, Kinematics};
 use systems::core::Pose2;
@@ -334,31 +334,41 @@ pub(super) fn resolve_route(
     Ok((route, pose))
 }
 
+/// What of a robot's file its outdoor parts depend on.
+pub(super) struct OutdoorTables<'a> {
+    pub gps: Option<&'a GpsFile>,
+    pub compass: Option<&'a CompassFile>,
+    pub camera: Option<&'a CameraFile>,
+    /// The robot has a wheel encoder.
+    pub has_encoder: bool,
+    /// The robot has a `behaviour` or `tasks` (a robot with a route may have neither).
+    pub driven_otherwise: bool,
+}
+
 /// The robot's GPS, compass and camera (its tables over the preset's), and the checks a route
 /// needs: the sensors it drives by, no behaviour or tasks, a goal other than the start.
 #[allow(clippy::type_complexity)]
 pub(super) fn resolve_outdoor_sensors(
     c: &Checker,
     p: &KeyPath,
-    r: &super::file::RobotFile,
+    t: &OutdoorTables<'_>,
     preset: Option<&Preset>,
     route: Option<&RouteConfig>,
-    has_encoder: bool,
 ) -> R<(Option<GpsSpec>, Option<CompassSpec>, Option<CameraSpec>)> {
-    let sensors = r.sensors.as_ref();
+    let has_encoder = t.has_encoder;
     let sp = p.key("sensors");
     let gps = over_preset(
-        sensors.and_then(|s| s.gps.as_ref()),
+        t.gps,
         preset.map(|pr| pr.gps.clone()),
         |f, base| resolve_gps(c, &sp.key("gps"), f, base),
     )?;
     let compass = over_preset(
-        sensors.and_then(|s| s.compass.as_ref()),
+        t.compass,
         preset.map(|pr| pr.compass.clone()),
         |f, base| resolve_compass(c, &sp.key("compass"), f, base),
     )?;
     let camera = over_preset(
-        sensors.and_then(|s| s.camera.as_ref()),
+        t.camera,
         preset.map(|pr| pr.camera.clone()),
         |f, base| resolve_camera(c, &sp.key("camera"), f, base),
     )?;
@@ -385,7 +395,7 @@ pub(super) fn resolve_outdoor_sensors(
                 ),
             );
         }
-        if r.behaviour.is_some() || !r.tasks.is_empty() {
+        if t.driven_otherwise {
             return c.err(
                 &p.key("route"),
                 "a robot with a route is driven by its road navigator: remove `behaviour` and `tasks`",

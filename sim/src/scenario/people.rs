@@ -2,8 +2,8 @@
 //! names the person and the key.
 
 use super::error::{KeyPath, ScenarioError};
-use super::file::PointOrPlace;
-use super::resolve::{Checker, R, check_name};
+use super::check::PointOrPlace;
+use super::check::{Checker, R, check_name};
 use serde::Deserialize;
 use systems::body::Person;
 use systems::body::people::{DEFAULT_RADIUS, DEFAULT_SPEED};

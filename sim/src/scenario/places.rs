@@ -2,14 +2,41 @@
 //! (`[places.<name>] pose = [x, y, yaw]`) and doors (`[doors.<name>] from, to, thickness`), with
 //! errors naming the places file and key.
 
+use serde::Deserialize;
 use super::DoorConfig;
 use super::error::{ErrorContext, KeyPath};
-use super::file::PlacesFile;
-use super::resolve::{Checker, R};
+use super::check::{Checker, R};
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::core::Pose2;
 use systems::world::OccupancyGrid;
+
+/// Named places next to a map: `[places.<name>] pose = [x, y, yaw]`.
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct PlacesFile {
+    #[serde(default)]
+    pub places: std::collections::BTreeMap<String, PlaceFile>,
+    /// Doors: `[doors.<name>] from = [x, y], to = [x, y], thickness = 0.15`.
+    #[serde(default)]
+    pub doors: std::collections::BTreeMap<String, DoorFile>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct DoorFile {
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+    pub thickness: Option<f64>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct PlaceFile {
+    pub pose: [f64; 3],
+    pub kind: Option<String>,
+    pub description: Option<String>,
+}
 
 /// Reads `ppath` (named by `key` of the scenario): its places and doors.
 pub(super) fn load_places(

@@ -2,9 +2,12 @@
 //! problem with the file, line and key.
 
 use super::error::{ErrorContext, KeyPath, ScenarioError};
+use super::check::{Checker, PointOrPlace, R};
 use super::file::*;
 use super::outdoor_robot;
 use super::sensors::{resolve_encoder, resolve_laser};
+use super::outdoor::RoadsConfig;
+use super::outdoor_robot::RouteConfig;
 use super::{RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -14,79 +17,97 @@ use systems::navigation::BehaviourKind;
 use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
 use systems::world::{Cell, OccupancyGrid, load_map};
 
-pub(super) type R<T> = Result<T, ScenarioError>;
-
-pub(super) struct Checker<'a> {
-    pub(super) cx: ErrorContext<'a>,
-}
-
-impl Checker<'_> {
-    pub(super) fn err<T>(&self, path: &KeyPath, msg: impl Into<String>) -> R<T> {
-        Err(self.cx.at(path, msg))
-    }
-
-    /// A finite number in [lo, hi] (either bound optional), `open_lo` excluding lo.
-    pub(super) fn range(
-        &self,
-        path: &KeyPath,
-        v: f64,
-        lo: Option<f64>,
-        hi: Option<f64>,
-        open_lo: bool,
-    ) -> R<f64> {
-        let below = match lo {
-            Some(l) if open_lo => v <= l,
-            Some(l) => v < l,
-            None => false,
-        };
-        let above = hi.is_some_and(|h| v > h);
-        if !v.is_finite() || below || above {
-            let want = match (lo, hi) {
-                (Some(l), Some(h)) if open_lo => format!("a number in ({l}, {h}]"),
-                (Some(l), Some(h)) => format!("a number in [{l}, {h}]"),
-                (Some(l), None) if open_lo => format!("a number greater than {l}"),
-                (Some(l), None) => format!("a number of at least {l}"),
-                (None, Some(h)) => format!("a number of at most {h}"),
-                (None, None) => "a finite number".to_string(),
-            };
-            return self.err(path, format!("expected {want}, got {v}"));
-        }
-        Ok(v)
-    }
-
-    pub(super) fn positive(&self, path: &KeyPath, v: f64) -> R<f64> {
-        self.range(path, v, Some(0.0), None, true)
-    }
-
-    pub(super) fn opt_positive(&self, path: &KeyPath, v: Option<f64>, default: f64) -> R<f64> {
-        match v {
-            Some(v) => self.positive(path, v),
-            None => Ok(default),
-        }
-    }
-
-    pub(super) fn finite(&self, path: &KeyPath, vals: &[f64]) -> R<()> {
-        if vals.iter().any(|v| !v.is_finite()) {
-            return self.err(path, format!("expected finite numbers, got {vals:?}"));
-        }
-        Ok(())
-    }
-}
-
-pub(super) fn check_name(name: &str) -> bool {
-    !name.is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-}
-
 pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str) -> R<Scenario> {
     let c = Checker {
         cx: ErrorContext::new(file_label.to_string(), text),
     };
     let f: ScenarioFile = toml::from_str(text).map_err(|e| c.cx.from_toml(&e))?;
     let root = KeyPath::default();
+    let header = resolve_header(&c, &root, &f, default_name)?;
+    let shapes = resolve_shapes(&c, &root, &f)?;
+    let roads = match &f.roads {
+        Some(r) => Some(super::outdoor::resolve_roads(
+            &c,
+            &root.key("roads"),
+            r,
+            base_dir,
+        )?),
+        None => None,
+    };
+    let zones = super::outdoor::resolve_zones(&c, &root.key("zones"), &f.zones)?;
+    let map = f.map.as_ref();
+    let grid = resolve_grid(&c, &root, map, &shapes, roads.as_ref(), base_dir)?;
+    let (places, doors) = match map.and_then(|m| m.places.as_ref()) {
+        Some(pf) => super::places::load_places(
+            &c,
+            &root.key("map").key("places"),
+            &base_dir.join(pf),
+            &grid,
+        )?,
+        None => (BTreeMap::new(), Vec::new()),
+    };
+    let world = World {
+        c: &c,
+        grid: &grid,
+        places: &places,
+    };
+    let record = resolve_record(&c, &root.key("record"), f.record.as_ref())?;
+    let mut robots: Vec<RobotConfig> = Vec::new();
+    for (i, r) in f.robots.iter().enumerate() {
+        let robot = resolve_robot(&world, &root.key("robots").index(i), i, r, roads.as_ref(), &robots)?;
+        robots.push(robot);
+    }
+    let events = super::events::resolve_events(
+        &c,
+        &root.key("events"),
+        &f.events,
+        header.duration,
+        super::events::Known {
+            robots: &robots,
+            doors: &doors,
+            grid: &grid,
+        },
+        &|p, v| world.point(p, v),
+        &|p, v| world.inside(p, v),
+        &|p, v| world.points(p, v),
+    )?;
+    let people = super::people::resolve_people(
+        &c,
+        &root.key("people"),
+        &f.people,
+        &|p, v| world.point(p, v),
+        &|p, v| world.inside(p, v),
+        &grid,
+    )?;
+    Ok(Scenario {
+        name: header.name,
+        description: f.description.unwrap_or_default(),
+        seed: header.seed,
+        dt: header.dt,
+        duration: header.duration,
+        source: file_label.to_string(),
+        grid,
+        places,
+        record,
+        robots,
+        events,
+        doors,
+        end_when_done: f.end_when_done.unwrap_or(false),
+        people,
+        roads,
+        zones,
+    })
+}
 
+/// The scenario's own keys: name, seed, time step, duration.
+struct Header {
+    name: String,
+    seed: u64,
+    dt: f64,
+    duration: f64,
+}
+
+fn resolve_header(c: &Checker, root: &KeyPath, f: &ScenarioFile, default_name: &str) -> R<Header> {
     let name = f.name.clone().unwrap_or_else(|| default_name.to_string());
     if !check_name(&name) {
         return c.err(
@@ -94,19 +115,24 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             format!("expected letters, digits, `_` or `-` (it names output files), got `{name}`"),
         );
     }
-    let seed = f.seed.unwrap_or(0);
     let dt = match f.dt {
         Some(v) => c.range(&root.key("dt"), v, Some(0.0), Some(1.0), true)?,
         None => 0.05,
     };
     let Some(duration) = f.duration else {
-        return c.err(&root, "missing key `duration` (simulated seconds)");
+        return c.err(root, "missing key `duration` (simulated seconds)");
     };
     let duration = c.positive(&root.key("duration"), duration)?;
+    Ok(Header {
+        name,
+        seed: f.seed.unwrap_or(0),
+        dt,
+        duration,
+    })
+}
 
-    // --- world
-    let map = f.map.unwrap_or_default();
-    let mpath = root.key("map");
+/// `[[walls]]`, `[[boxes]]` and `[[discs]]`: the vector shapes rasterised into the map.
+fn resolve_shapes(c: &Checker, root: &KeyPath, f: &ScenarioFile) -> R<Vec<Shape>> {
     let mut shapes = Vec::new();
     for (i, w) in f.walls.iter().enumerate() {
         let p = root.key("walls").index(i);
@@ -140,17 +166,23 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             radius,
         });
     }
-    let roads = match &f.roads {
-        Some(r) => Some(super::outdoor::resolve_roads(
-            &c,
-            &root.key("roads"),
-            r,
-            base_dir,
-        )?),
-        None => None,
-    };
-    let zones = super::outdoor::resolve_zones(&c, &root.key("zones"), &f.zones)?;
-    let mut grid: OccupancyGrid = match &map.file {
+    Ok(shapes)
+}
+
+/// The occupancy grid: the map file, or a grid over the shapes and roads, with the shapes drawn
+/// in.
+fn resolve_grid(
+    c: &Checker,
+    root: &KeyPath,
+    map: Option<&MapFile>,
+    shapes: &[Shape],
+    roads: Option<&RoadsConfig>,
+    base_dir: &Path,
+) -> R<OccupancyGrid> {
+    let mpath = root.key("map");
+    let file = map.and_then(|m| m.file.as_ref());
+    let resolution = map.and_then(|m| m.resolution);
+    let mut grid: OccupancyGrid = match file {
         Some(file) => {
             let path = base_dir.join(file);
             load_map(&path).map_err(|e| c.cx.at(&mpath.key("file"), e.to_string()))?
@@ -158,20 +190,20 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         None => {
             // outdoors the grid only carries obstacles (trees, buildings): 0.2 m cells
             let default_res = if roads.is_some() { 0.2 } else { 0.05 };
-            let res = c.opt_positive(&mpath.key("resolution"), map.resolution, default_res)?;
-            let outdoor = roads.as_ref().map(|r| (r.graph.bounds(), r.margin));
-            match grid_for_world(&shapes, outdoor, res) {
+            let res = c.opt_positive(&mpath.key("resolution"), resolution, default_res)?;
+            let outdoor = roads.map(|r| (r.graph.bounds(), r.margin));
+            match grid_for_world(shapes, outdoor, res) {
                 Some(g) => g,
                 None => {
                     return c.err(
-                        &root,
+                        root,
                         "the world is empty: give `map.file` (a ROS map_server YAML), `[roads]` or walls, boxes or discs",
                     );
                 }
             }
         }
     };
-    if map.file.is_some() && map.resolution.is_some() {
+    if file.is_some() && resolution.is_some() {
         return c.err(
             &mpath.key("resolution"),
             "the resolution comes from the map file; remove this key",
@@ -180,75 +212,19 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
     if grid.width * grid.height > 400_000_000 {
         return c.err(&mpath, "the map has more than 400 million cells");
     }
-    for s in &shapes {
+    for s in shapes {
         rasterize(&mut grid, s);
     }
+    Ok(grid)
+}
 
-    let (places, doors) = match &map.places {
-        Some(pf) => {
-            super::places::load_places(&c, &mpath.key("places"), &base_dir.join(pf), &grid)?
-        }
-        None => (BTreeMap::new(), Vec::new()),
-    };
-
-    let point = |path: &KeyPath, p: &PointOrPlace| -> R<Pose2> {
-        match p {
-            PointOrPlace::Coords(v) if v.len() == 2 || v.len() == 3 => {
-                c.finite(path, v)?;
-                Ok(Pose2::new(v[0], v[1], v.get(2).copied().unwrap_or(0.0)))
-            }
-            PointOrPlace::Coords(v) => c.err(
-                path,
-                format!("expected [x, y] or [x, y, yaw], got {} numbers", v.len()),
-            ),
-            PointOrPlace::Place(name) => places.get(name).copied().ok_or_else(|| {
-                let known: Vec<&str> = places.keys().map(String::as_str).collect();
-                c.cx.at(
-                    path,
-                    if known.is_empty() {
-                        format!("unknown place `{name}` (the map has no places file)")
-                    } else {
-                        format!("unknown place `{name}`; known places: {}", known.join(", "))
-                    },
-                )
-            }),
-        }
-    };
-    let inside = |path: &KeyPath, p: &Pose2| -> R<()> {
-        let b = grid.bounds();
-        if p.x < b[0] || p.y < b[1] || p.x > b[2] || p.y > b[3] {
-            return c.err(
-                path,
-                format!(
-                    "({:.3}, {:.3}) lies outside the map [{:.2}, {:.2}] × [{:.2}, {:.2}]",
-                    p.x, p.y, b[0], b[2], b[1], b[3]
-                ),
-            );
-        }
-        Ok(())
-    };
-    let points = |path: &KeyPath, pts: &Option<Vec<PointOrPlace>>| -> R<Vec<[f64; 2]>> {
-        let Some(pts) = pts else {
-            return c.err(path, "missing `points` (a list of [x, y] or place names)");
-        };
-        if pts.is_empty() {
-            return c.err(&path.key("points"), "expected at least one point");
-        }
-        let mut out = Vec::new();
-        for (i, p) in pts.iter().enumerate() {
-            let pp = path.key("points").index(i);
-            let pose = point(&pp, p)?;
-            inside(&pp, &pose)?;
-            out.push([pose.x, pose.y]);
-        }
-        Ok(out)
-    };
-
-    // --- recording
-    let rec = f.record.unwrap_or_default();
-    let rp = root.key("record");
+/// `[record]`: the recording's rates, over [`RecordConfig::default`].
+fn resolve_record(c: &Checker, rp: &KeyPath, rec: Option<&RecordFile>) -> R<RecordConfig> {
     let d = RecordConfig::default();
-    let record = RecordConfig {
+    let Some(rec) = rec else {
+        return Ok(d);
+    };
+    Ok(RecordConfig {
         rate: c.opt_positive(&rp.key("rate"), rec.rate, d.rate)?,
         scan_rate: c.opt_positive(&rp.key("scan_rate"), rec.scan_rate, d.scan_rate)?,
         path_rate: c.opt_positive(&rp.key("path_rate"), rec.path_rate, d.path_rate)?,
@@ -263,280 +239,341 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
             Some(v) => c.range(&rp.key("slam_rate"), v, Some(0.0), None, false)?,
             None => d.slam_rate,
         },
-    };
+    })
+}
 
-    // --- robots
-    let mut robots: Vec<RobotConfig> = Vec::new();
-    for (i, r) in f.robots.iter().enumerate() {
-        let p = root.key("robots").index(i);
-        if !check_name(&r.name) {
-            return c.err(
-                &p.key("name"),
-                format!("expected letters, digits, `_` or `-`, got `{}`", r.name),
-            );
+/// The map and its places, as every robot, event and person reads points from them.
+struct World<'a> {
+    c: &'a Checker<'a>,
+    grid: &'a OccupancyGrid,
+    places: &'a BTreeMap<String, Pose2>,
+}
+
+impl World<'_> {
+    /// A pose from coordinates (`[x, y]` or `[x, y, yaw]`) or a place name.
+    fn point(&self, path: &KeyPath, p: &PointOrPlace) -> R<Pose2> {
+        let c = self.c;
+        match p {
+            PointOrPlace::Coords(v) if v.len() == 2 || v.len() == 3 => {
+                c.finite(path, v)?;
+                Ok(Pose2::new(v[0], v[1], v.get(2).copied().unwrap_or(0.0)))
+            }
+            PointOrPlace::Coords(v) => c.err(
+                path,
+                format!("expected [x, y] or [x, y, yaw], got {} numbers", v.len()),
+            ),
+            PointOrPlace::Place(name) => self.places.get(name).copied().ok_or_else(|| {
+                let known: Vec<&str> = self.places.keys().map(String::as_str).collect();
+                c.cx.at(
+                    path,
+                    if known.is_empty() {
+                        format!("unknown place `{name}` (the map has no places file)")
+                    } else {
+                        format!("unknown place `{name}`; known places: {}", known.join(", "))
+                    },
+                )
+            }),
         }
-        if robots.iter().any(|o| o.name == r.name) {
-            return c.err(&p.key("name"), format!("duplicate robot name `{}`", r.name));
-        }
-        let preset = match &r.preset {
-            Some(name) => Some(outdoor_robot::preset(name).map_or_else(
-                || {
-                    c.err(
-                        &p.key("preset"),
-                        format!(
-                            "unknown robot preset `{name}`; known: {}",
-                            outdoor_robot::PRESETS.join(", ")
-                        ),
-                    )
-                },
-                Ok,
-            )?),
-            None => None,
-        };
-        let footprint = match (&r.footprint, &preset) {
-            (None, Some(pr)) => pr.footprint.clone(),
-            (f, _) => resolve_footprint(&c, &p.key("footprint"), f.as_ref())?,
-        };
-        let (start, route) = match (&r.start, &r.route) {
-            (Some(_), Some(_)) => {
-                return c.err(
-                    &p.key("start"),
-                    "a robot with a `route` starts on its road at the route's `start`: remove `start`",
-                );
-            }
-            (Some(s), None) => (point(&p.key("start"), s)?, None),
-            (None, Some(rf)) => {
-                let (route, pose) =
-                    outdoor_robot::resolve_route(&c, &p.key("route"), rf, roads.as_ref())?;
-                (pose, Some(route))
-            }
-            (None, None) => {
-                return c.err(&p, "missing key `start` ([x, y, yaw] or a place name)");
-            }
-        };
-        inside(&p.key("start"), &start)?;
-        if !grid.disc_is_clear(start.x, start.y, footprint.bounding_radius()) {
-            return c.err(
-                &p.key("start"),
+    }
+
+    /// An error unless `p` lies on the map.
+    fn inside(&self, path: &KeyPath, p: &Pose2) -> R<()> {
+        let b = self.grid.bounds();
+        if p.x < b[0] || p.y < b[1] || p.x > b[2] || p.y > b[3] {
+            return self.c.err(
+                path,
                 format!(
-                    "the robot at ({:.2}, {:.2}) would overlap an obstacle (footprint radius {:.2} m)",
-                    start.x,
-                    start.y,
-                    footprint.bounding_radius()
+                    "({:.3}, {:.3}) lies outside the map [{:.2}, {:.2}] × [{:.2}, {:.2}]",
+                    p.x, p.y, b[0], b[2], b[1], b[3]
                 ),
             );
         }
-        let kinematics = match (&r.kinematics, &preset) {
-            (None, Some(pr)) => pr.kinematics.clone(),
-            (k, _) => resolve_kinematics(&c, &p.key("kinematics"), k.as_ref())?,
-        };
-        let bp = p.key("behaviour");
-        let (behaviour, speed, tolerance) = match &r.behaviour {
-            None => (BehaviourKind::Idle, 0.6, 0.4),
-            Some(b) => {
-                let speed = c.opt_positive(&bp.key("speed"), b.speed, 0.6)?;
-                if speed > kinematics.max_speed() + 1e-9 {
-                    return c.err(
-                        &bp.key("speed"),
-                        format!(
-                            "{speed} m/s exceeds the drive's top speed of {:.3} m/s",
-                            kinematics.max_speed()
-                        ),
-                    );
-                }
-                let tolerance = c.opt_positive(&bp.key("tolerance"), b.tolerance, 0.4)?;
-                let kind = match b.kind {
-                    BehaviourType::Idle | BehaviourType::Wander => {
-                        if b.points.is_some() {
-                            return c.err(
-                                &bp.key("points"),
-                                "only a `waypoints` behaviour takes points",
-                            );
-                        }
-                        if b.looping.is_some() {
-                            return c
-                                .err(&bp.key("loop"), "only a `waypoints` behaviour takes `loop`");
-                        }
-                        if b.kind == BehaviourType::Idle {
-                            BehaviourKind::Idle
-                        } else {
-                            BehaviourKind::Wander
-                        }
-                    }
-                    BehaviourType::Waypoints => BehaviourKind::Waypoints {
-                        points: points(&bp, &b.points)?,
-                        looping: b.looping.unwrap_or(false),
-                    },
-                };
-                (kind, speed, tolerance)
-            }
-        };
-        let sensors = r.sensors.as_ref();
-        let sp = p.key("sensors");
-        let laser = match sensors.and_then(|s| s.laser.as_ref()) {
-            Some(l) => Some(resolve_laser(&c, &sp.key("laser"), l)?),
-            None => None,
-        };
-        let encoder = match sensors.and_then(|s| s.encoder.as_ref()) {
-            Some(e) => Some(resolve_encoder(&c, &sp.key("encoder"), e)?),
-            None => preset.as_ref().map(|pr| pr.encoder.clone()),
-        };
-        let default_sonar = super::sonar::SonarFile::default();
-        let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
-            Some(s) => Some(s),
-            None if preset.as_ref().is_some_and(|pr| pr.sonars) => Some(&default_sonar),
-            None => None,
-        };
-        let sonar = match sonar {
-            Some(s) => {
-                let sp = sp.key("sonar");
-                Some(super::sonar::resolve_sonar(
-                    &c, &sp, &r.name, &footprint, s,
-                )?)
-            }
-            None => None,
-        };
-        let (gps, compass, camera) = outdoor_robot::resolve_outdoor_sensors(
-            &c,
-            &p,
-            r,
-            preset.as_ref(),
-            route.as_ref(),
-            encoder.is_some(),
-        )?;
-        let lp = p.key("localization");
-        let localizers = super::localizers::resolve_localizers(
-            &c,
-            &lp,
-            &r.localization,
-            &start,
-            &|path: &KeyPath, v: &PointOrPlace| {
-                let pose = point(path, v)?;
-                inside(path, &pose)?;
-                Ok(pose)
-            },
-        )?;
-        let mut localizers = localizers;
-        let slam =
-            super::slam::resolve_slam(&c, &p.key("slam"), r.slam.as_ref(), &start, &localizers)?;
-        if !slam.is_empty() && (laser.is_none() || encoder.is_none()) {
-            return c.err(
-                &p.key("slam"),
-                "SLAM reads the laser and the wheel odometry: give the robot \
-                 `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
-            );
-        }
-        localizers.extend(slam);
-        if !localizers.is_empty() && (laser.is_none() || encoder.is_none()) {
-            return c.err(
-                &lp,
-                "localizers read the laser and the wheel odometry: give the robot \
-                 `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
-            );
-        }
-        let navigation = super::navigation::resolve_navigation(
-            &c,
-            &p,
-            r.navigation.as_ref(),
-            &r.tasks,
-            super::navigation::RobotParts {
-                kinematics: &kinematics,
-                footprint: &footprint,
-                localizers: &localizers,
-                index: i,
-            },
-            &|path: &KeyPath, v: &PointOrPlace| {
-                let pose = point(path, v)?;
-                inside(path, &pose)?;
-                if !grid.disc_is_clear(pose.x, pose.y, footprint.bounding_radius()) {
-                    return c.err(
-                        path,
-                        format!(
-                            "the goal ({:.2}, {:.2}) is too close to an obstacle for the robot (radius {:.2} m)",
-                            pose.x,
-                            pose.y,
-                            footprint.bounding_radius()
-                        ),
-                    );
-                }
-                Ok(pose)
-            },
-        )?;
-        if navigation.is_some() {
-            if r.behaviour.is_some() {
-                return c.err(
-                    &bp,
-                    "a robot with tasks is driven by its navigator: remove `behaviour`",
-                );
-            }
-            if encoder.is_none() {
-                return c.err(
-                    &p.key("tasks"),
-                    "a robot with tasks navigates by its odometry and localization: give it `[robots.sensors.encoder]`",
-                );
-            }
-        }
-        if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
-            return c.err(
-                &bp.key("type"),
-                "a `waypoints` robot navigates by its odometry: give it `[robots.sensors.encoder]`",
-            );
-        }
-        robots.push(RobotConfig {
-            name: r.name.clone(),
-            start,
-            footprint,
-            kinematics,
-            behaviour,
-            speed,
-            tolerance,
-            laser,
-            encoder,
-            sonar,
-            localizers,
-            navigation,
-            gps,
-            compass,
-            camera,
-            route,
-        });
+        Ok(())
     }
 
-    let events = super::events::resolve_events(
-        &c,
-        &root.key("events"),
-        &f.events,
-        duration,
-        super::events::Known {
-            robots: &robots,
-            doors: &doors,
-            grid: &grid,
-        },
-        &point,
-        &inside,
-        &points,
-    )?;
-    let people =
-        super::people::resolve_people(&c, &root.key("people"), &f.people, &point, &inside, &grid)?;
+    /// The `points` key under `path`: at least one point, each on the map.
+    fn points(&self, path: &KeyPath, pts: &Option<Vec<PointOrPlace>>) -> R<Vec<[f64; 2]>> {
+        let Some(pts) = pts else {
+            return self
+                .c
+                .err(path, "missing `points` (a list of [x, y] or place names)");
+        };
+        if pts.is_empty() {
+            return self.c.err(&path.key("points"), "expected at least one point");
+        }
+        let mut out = Vec::new();
+        for (i, p) in pts.iter().enumerate() {
+            let pp = path.key("points").index(i);
+            let pose = self.point(&pp, p)?;
+            self.inside(&pp, &pose)?;
+            out.push([pose.x, pose.y]);
+        }
+        Ok(out)
+    }
 
-    Ok(Scenario {
-        name,
-        description: f.description.unwrap_or_default(),
-        seed,
-        dt,
-        duration,
-        source: file_label.to_string(),
-        grid,
-        places,
-        record,
-        robots,
-        events,
-        doors,
-        end_when_done: f.end_when_done.unwrap_or(false),
-        people,
-        roads,
-        zones,
+    /// A point on the map.
+    fn point_inside(&self, path: &KeyPath, v: &PointOrPlace) -> R<Pose2> {
+        let pose = self.point(path, v)?;
+        self.inside(path, &pose)?;
+        Ok(pose)
+    }
+}
+
+/// One `[[robots]]` table (`others`: the robots before it).
+fn resolve_robot(
+    w: &World,
+    p: &KeyPath,
+    i: usize,
+    r: &RobotFile,
+    roads: Option<&RoadsConfig>,
+    others: &[RobotConfig],
+) -> R<RobotConfig> {
+    let c = w.c;
+    if !check_name(&r.name) {
+        return c.err(
+            &p.key("name"),
+            format!("expected letters, digits, `_` or `-`, got `{}`", r.name),
+        );
+    }
+    if others.iter().any(|o| o.name == r.name) {
+        return c.err(&p.key("name"), format!("duplicate robot name `{}`", r.name));
+    }
+    let preset = match &r.preset {
+        Some(name) => Some(outdoor_robot::preset(name).map_or_else(
+            || {
+                c.err(
+                    &p.key("preset"),
+                    format!(
+                        "unknown robot preset `{name}`; known: {}",
+                        outdoor_robot::PRESETS.join(", ")
+                    ),
+                )
+            },
+            Ok,
+        )?),
+        None => None,
+    };
+    let footprint = match (&r.footprint, &preset) {
+        (None, Some(pr)) => pr.footprint.clone(),
+        (f, _) => resolve_footprint(c, &p.key("footprint"), f.as_ref())?,
+    };
+    let (start, route) = resolve_start(w, p, r, roads, &footprint)?;
+    let kinematics = match (&r.kinematics, &preset) {
+        (None, Some(pr)) => pr.kinematics.clone(),
+        (k, _) => resolve_kinematics(c, &p.key("kinematics"), k.as_ref())?,
+    };
+    let bp = p.key("behaviour");
+    let (behaviour, speed, tolerance) =
+        resolve_behaviour(w, &bp, r.behaviour.as_ref(), &kinematics)?;
+    let sensors = r.sensors.as_ref();
+    let sp = p.key("sensors");
+    let laser = match sensors.and_then(|s| s.laser.as_ref()) {
+        Some(l) => Some(resolve_laser(c, &sp.key("laser"), l)?),
+        None => None,
+    };
+    let encoder = match sensors.and_then(|s| s.encoder.as_ref()) {
+        Some(e) => Some(resolve_encoder(c, &sp.key("encoder"), e)?),
+        None => preset.as_ref().map(|pr| pr.encoder.clone()),
+    };
+    let default_sonar = super::sonar::SonarFile::default();
+    let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
+        Some(s) => Some(s),
+        None if preset.as_ref().is_some_and(|pr| pr.sonars) => Some(&default_sonar),
+        None => None,
+    };
+    let sonar = match sonar {
+        Some(s) => Some(super::sonar::resolve_sonar(
+            c,
+            &sp.key("sonar"),
+            &r.name,
+            &footprint,
+            s,
+        )?),
+        None => None,
+    };
+    let tables = outdoor_robot::OutdoorTables {
+        gps: sensors.and_then(|s| s.gps.as_ref()),
+        compass: sensors.and_then(|s| s.compass.as_ref()),
+        camera: sensors.and_then(|s| s.camera.as_ref()),
+        has_encoder: encoder.is_some(),
+        driven_otherwise: r.behaviour.is_some() || !r.tasks.is_empty(),
+    };
+    let (gps, compass, camera) =
+        outdoor_robot::resolve_outdoor_sensors(c, p, &tables, preset.as_ref(), route.as_ref())?;
+    let lp = p.key("localization");
+    let mut localizers = super::localizers::resolve_localizers(
+        c,
+        &lp,
+        &r.localization,
+        &start,
+        &|path, v| w.point_inside(path, v),
+    )?;
+    let slam = super::slam::resolve_slam(c, &p.key("slam"), r.slam.as_ref(), &start, &localizers)?;
+    if !slam.is_empty() && (laser.is_none() || encoder.is_none()) {
+        return c.err(
+            &p.key("slam"),
+            "SLAM reads the laser and the wheel odometry: give the robot \
+             `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
+        );
+    }
+    localizers.extend(slam);
+    if !localizers.is_empty() && (laser.is_none() || encoder.is_none()) {
+        return c.err(
+            &lp,
+            "localizers read the laser and the wheel odometry: give the robot \
+             `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
+        );
+    }
+    let navigation = super::navigation::resolve_navigation(
+        c,
+        p,
+        r.navigation.as_ref(),
+        &r.tasks,
+        super::navigation::RobotParts {
+            kinematics: &kinematics,
+            footprint: &footprint,
+            localizers: &localizers,
+            index: i,
+        },
+        &|path, v| {
+            let pose = w.point_inside(path, v)?;
+            if !w.grid.disc_is_clear(pose.x, pose.y, footprint.bounding_radius()) {
+                return c.err(
+                    path,
+                    format!(
+                        "the goal ({:.2}, {:.2}) is too close to an obstacle for the robot (radius {:.2} m)",
+                        pose.x,
+                        pose.y,
+                        footprint.bounding_radius()
+                    ),
+                );
+            }
+            Ok(pose)
+        },
+    )?;
+    if navigation.is_some() {
+        if r.behaviour.is_some() {
+            return c.err(
+                &bp,
+                "a robot with tasks is driven by its navigator: remove `behaviour`",
+            );
+        }
+        if encoder.is_none() {
+            return c.err(
+                &p.key("tasks"),
+                "a robot with tasks navigates by its odometry and localization: give it `[robots.sensors.encoder]`",
+            );
+        }
+    }
+    if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
+        return c.err(
+            &bp.key("type"),
+            "a `waypoints` robot navigates by its odometry: give it `[robots.sensors.encoder]`",
+        );
+    }
+    Ok(RobotConfig {
+        name: r.name.clone(),
+        start,
+        footprint,
+        kinematics,
+        behaviour,
+        speed,
+        tolerance,
+        laser,
+        encoder,
+        sonar,
+        localizers,
+        navigation,
+        gps,
+        compass,
+        camera,
+        route,
     })
+}
+
+/// A robot's start pose (`start`, or the start of its `route`), clear of obstacles.
+fn resolve_start(
+    w: &World,
+    p: &KeyPath,
+    r: &RobotFile,
+    roads: Option<&RoadsConfig>,
+    footprint: &Footprint,
+) -> R<(Pose2, Option<RouteConfig>)> {
+    let c = w.c;
+    let (start, route) = match (&r.start, &r.route) {
+        (Some(_), Some(_)) => {
+            return c.err(
+                &p.key("start"),
+                "a robot with a `route` starts on its road at the route's `start`: remove `start`",
+            );
+        }
+        (Some(s), None) => (w.point(&p.key("start"), s)?, None),
+        (None, Some(rf)) => {
+            let (route, pose) = outdoor_robot::resolve_route(c, &p.key("route"), rf, roads)?;
+            (pose, Some(route))
+        }
+        (None, None) => {
+            return c.err(p, "missing key `start` ([x, y, yaw] or a place name)");
+        }
+    };
+    w.inside(&p.key("start"), &start)?;
+    if !w.grid.disc_is_clear(start.x, start.y, footprint.bounding_radius()) {
+        return c.err(
+            &p.key("start"),
+            format!(
+                "the robot at ({:.2}, {:.2}) would overlap an obstacle (footprint radius {:.2} m)",
+                start.x,
+                start.y,
+                footprint.bounding_radius()
+            ),
+        );
+    }
+    Ok((start, route))
+}
+
+/// A robot's `behaviour`: its kind, speed and waypoint tolerance (idle at 0.6 m/s and 0.4 m
+/// without one).
+fn resolve_behaviour(
+    w: &World,
+    bp: &KeyPath,
+    b: Option<&BehaviourFile>,
+    kinematics: &Kinematics,
+) -> R<(BehaviourKind, f64, f64)> {
+    let c = w.c;
+    let Some(b) = b else {
+        return Ok((BehaviourKind::Idle, 0.6, 0.4));
+    };
+    let speed = c.opt_positive(&bp.key("speed"), b.speed, 0.6)?;
+    if speed > kinematics.max_speed() + 1e-9 {
+        return c.err(
+            &bp.key("speed"),
+            format!(
+                "{speed} m/s exceeds the drive's top speed of {:.3} m/s",
+                kinematics.max_speed()
+            ),
+        );
+    }
+    let tolerance = c.opt_positive(&bp.key("tolerance"), b.tolerance, 0.4)?;
+    let kind = match b.kind {
+        BehaviourType::Idle | BehaviourType::Wander => {
+            if b.points.is_some() {
+                return c.err(&bp.key("points"), "only a `waypoints` behaviour takes points");
+            }
+            if b.looping.is_some() {
+                return c.err(&bp.key("loop"), "only a `waypoints` behaviour takes `loop`");
+            }
+            if b.kind == BehaviourType::Idle {
+                BehaviourKind::Idle
+            } else {
+                BehaviourKind::Wander
+            }
+        }
+        BehaviourType::Waypoints => BehaviourKind::Waypoints {
+            points: w.points(bp, &b.points)?,
+            looping: b.looping.unwrap_or(false),
+        },
+    };
+    Ok((kind, speed, tolerance))
 }
 
 fn resolve_footprint(c: &Checker, p: &KeyPath, f: Option<&FootprintFile>) -> R<Footprint> {

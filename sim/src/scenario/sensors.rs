@@ -1,11 +1,37 @@
 //! `[robots.sensors.laser]` and `[robots.sensors.encoder]`: presets with overrides, checked,
 //! and the range limits every range sensor shares.
 
+use serde::Deserialize;
 use super::error::KeyPath;
-use super::file::{EncoderFile, LaserFile};
-use super::resolve::{Checker, R};
+use super::check::{Checker, R};
 use systems::core::Pose2;
 use systems::sensors::{EncoderSpec, LaserSpec};
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct LaserFile {
+    pub preset: Option<String>,
+    pub fov_deg: Option<f64>,
+    pub increment_deg: Option<f64>,
+    pub min_range: Option<f64>,
+    pub max_range: Option<f64>,
+    pub rate: Option<f64>,
+    pub noise_std: Option<f64>,
+    pub dropout: Option<f64>,
+    /// [x, y, yaw] in the robot frame.
+    pub mount: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize, Debug, Default)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderFile {
+    pub ticks_per_rev: Option<u32>,
+    pub left_radius_error: Option<f64>,
+    pub right_radius_error: Option<f64>,
+    pub wheel_base_error: Option<f64>,
+    pub slip_std: Option<f64>,
+    pub rate: Option<f64>,
+}
 
 /// The keys every range sensor (laser, sonar) has, as written.
 pub(super) struct RangeKeys {

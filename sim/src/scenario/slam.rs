@@ -4,7 +4,7 @@
 
 use super::error::KeyPath;
 use super::localizers::{LocalizerConfig, LocalizerKind};
-use super::resolve::{Checker, R};
+use super::check::{Checker, R};
 use serde::Deserialize;
 use systems::core::Pose2;
 use systems::mapping::de_map_match::DeMapMatcher;
@@ -93,7 +93,7 @@ pub struct SlamFile {
     pub p_miss: Option<f64>,
     /// How far a beam without a return clears free space (m).
     pub clear_range: Option<f64>,
-    /// RBPF only, under GMapping's names (001_6ab7973871dfdca6.txt): number of particles, the
+    /// RBPF only, under GMapping's names ([SLAM thesis]): number of particles, the
     /// motion that triggers an update (m, rad), the proposal's sampling grid (m, rad).
     pub particles: Option<usize>,
     #[serde(rename = "linearUpdate")]
@@ -164,7 +164,7 @@ pub(super) fn resolve_slam(
     for (i, s) in list.items().iter().enumerate() {
         let sp = if many { p.index(i) } else { p.clone() };
         let name = match &s.name {
-            Some(n) if !super::resolve::check_name(n) => {
+            Some(n) if !super::check::check_name(n) => {
                 return c.err(
                     &sp.key("name"),
                     format!("expected letters, digits, `_` or `-`, got `{n}`"),

@@ -6,7 +6,7 @@
 
 use super::error::{ErrorContext, KeyPath, ScenarioError};
 use super::localizers::LocalizerConfig;
-use super::resolve::Checker;
+use super::check::Checker;
 use super::slam::SlamList;
 use systems::core::Pose2;
 

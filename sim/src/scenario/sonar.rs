@@ -6,7 +6,7 @@
 //! either, the robot gets the `hospital` layout. Errors name the robot and the key.
 
 use super::error::KeyPath;
-use super::resolve::{Checker, R};
+use super::check::{Checker, R};
 use serde::Deserialize;
 use systems::body::Footprint;
 use systems::core::Pose2;

@@ -5,7 +5,7 @@
 
 use crate::run_ok;
 use crate::sim as sim_command;
-use sim::scans::{SCANS_HEADER, ScanRecord, read_scans};
+use sim::formats::scans::{SCANS_HEADER, ScanRecord, read_scans};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::sync::OnceLock;

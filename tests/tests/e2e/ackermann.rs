@@ -1,4 +1,4 @@
-//! A car-like (Ackermann) robot driving its tasks through the whole stack (issue 4, item 3):
+//! A car-like (Ackermann) robot driving its tasks through the whole stack:
 //! planner, pure pursuit limited to the car's turning circle, physics. It never turns on the
 //! spot, never steers tighter than its turning radius and reaches both goals, the second of
 //! which lies behind it.

@@ -5,7 +5,7 @@
 use crate::common::*;
 use serde_json::Value;
 use sim::batch::{BatchArgs, BatchReport, batch_command};
-use sim::run_cmd::parse_args;
+use sim::options::parse_args;
 use std::path::Path;
 
 fn batch(args: &[&str]) -> Result<BatchReport, String> {

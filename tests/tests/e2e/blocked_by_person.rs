@@ -1,4 +1,4 @@
-//! A robot whose way a person blocks (issue 4): it stops short of the person, waits, and then
+//! A robot whose way a person blocks: it stops short of the person, waits, and then
 //! passes, either because the person walks off or, when the person stays, by planning around.
 //! Run tick by tick on ground truth, so the tests see where both bodies were at every step.
 

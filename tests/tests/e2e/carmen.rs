@@ -1,4 +1,4 @@
-//! CARMEN logs and maps on the command line (issue 5, items 1, 7 and 9): `sim run
+//! CARMEN logs and maps on the command line: `sim run
 //! --carmen-out` / `--save-map`, `sim slam --carmen`, and the SLAM entities of the recordings,
 //! parsed as the binary parses them (exit codes and printed text: sim/tests/cli/carmen.rs).
 
@@ -259,11 +259,11 @@ impl SquareGraph {
 
 #[test]
 fn a_pose_graph_is_recorded_with_its_edges_and_nodes() {
-    use sim::record::slam::{log_slam_state, slam_entity};
+    use sim::record::rrd::slam::{log_slam_state, slam_entity};
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("g.rrd");
     let rec = sim::record::rrd::open_recording(&path, "graph").unwrap();
-    let mut rec = sim::record::stream::RrdStream::new(rec);
+    let mut rec = sim::record::rrd::stream::RrdStream::new(rec);
     rec.set_duration_secs("sim_time", 1.0);
     log_slam_state(&mut rec, &slam_entity("r", "square", 1), &SquareGraph).unwrap();
     rec.flush_blocking().unwrap();

@@ -78,15 +78,16 @@ walls = [
 
 /// `sim run ARGS` as the binary runs it: Err (a non-zero exit) carries the message it prints.
 pub fn sim_run(args: &[&str]) -> Result<(), String> {
-    use sim::run_cmd::{RunArgs, parse_args, run_command};
+    use sim::cli::run::{RunArgs, run_command};
+    use sim::options::parse_args;
     let a: RunArgs = parse_args(args).map_err(|e| e.to_string())?;
     run_command(&a).map_err(|e| format!("{e:#}"))
 }
 
 /// `sim slam ARGS` as the binary runs it, with its report.
-pub fn sim_slam(args: &[&str]) -> Result<sim::slam_cmd::report::SlamReport, String> {
-    use sim::run_cmd::parse_args;
-    use sim::slam_cmd::{SlamArgs, run_slam_command};
+pub fn sim_slam(args: &[&str]) -> Result<sim::log_slam::report::SlamReport, String> {
+    use sim::options::parse_args;
+    use sim::log_slam::{SlamArgs, run_slam_command};
     let a: SlamArgs = parse_args(args).map_err(|e| e.to_string())?;
     run_slam_command(&a).map_err(|e| format!("{e:#}"))
 }

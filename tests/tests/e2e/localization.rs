@@ -196,7 +196,7 @@ fn trajectories_are_written_for_evo() {
     sc.robots.truncate(1);
     sc.robots[0].localizers.truncate(1);
     let out = run(&sc);
-    let files = sim::record::write_trajectories(dir.path(), &out.localization).unwrap();
+    let files = sim::formats::tum::write_trajectories(dir.path(), &out.localization).unwrap();
     assert_eq!(files.len(), 2);
     let est = std::fs::read_to_string(dir.path().join("r1/mcl.tum")).unwrap();
     let truth = std::fs::read_to_string(dir.path().join("r1/mcl.truth.tum")).unwrap();
@@ -363,7 +363,7 @@ fn evo_agrees_with_our_ate_and_rpe() {
     assert_eq!(sc.robots[0].localizers.len(), 2);
     let out = run(&sc);
     let traj = dir.path().join("traj");
-    sim::record::write_trajectories(&traj, &out.localization).unwrap();
+    sim::formats::tum::write_trajectories(&traj, &out.localization).unwrap();
     let summary = dir.path().join("summary.json");
     std::fs::write(&summary, serde_json::to_string(&out.summary).unwrap()).unwrap();
     let res = std::process::Command::new(evo_venv().join("bin/python"))

@@ -1,4 +1,4 @@
-//! Task-driven navigation (issue 4): deliveries on the hospital floor, unreachable goals,
+//! Task-driven navigation: deliveries on the hospital floor, unreachable goals,
 //! robots meeting head-on in a one-lane corridor, and the scenario errors of tasks and doors.
 
 use crate::common::*;
@@ -8,7 +8,7 @@ fn run(text: &str) -> sim::RunOutput {
     run_scenario(&scenario(text), &RunOptions::default()).expect("runs")
 }
 
-fn nav(out: &sim::RunOutput, robot: usize) -> &sim::summary::NavigationSummary {
+fn nav(out: &sim::RunOutput, robot: usize) -> &sim::run::summary::NavigationSummary {
     out.summary.robots[robot]
         .navigation
         .as_ref()

@@ -1,4 +1,4 @@
-//! The written .rrd opens with the Rerun 0.36.3 tools and holds the entity paths of DESIGN.md on
+//! The written .rrd opens with the Rerun 0.36.3 tools and holds the entity paths of `systems/ARCHITECTURE.md` on
 //! the `sim_time` timeline, including every localizer's estimate, particle set and error series.
 
 use crate::common::*;

@@ -7,7 +7,7 @@ use std::path::Path;
 
 fn sim_replay(args: &[&str]) -> Result<(), String> {
     use sim::replay::{ReplayArgs, replay_command};
-    let a: ReplayArgs = sim::run_cmd::parse_args(args).map_err(|e| e.to_string())?;
+    let a: ReplayArgs = sim::options::parse_args(args).map_err(|e| e.to_string())?;
     replay_command(&a).map_err(|e| format!("{e:#}"))
 }
 

@@ -1,4 +1,4 @@
-//! SLAM end to end (issue 5): the bundled hospital_loop run with scan-to-map SLAM on the robot,
+//! SLAM end to end: the bundled hospital_loop run with scan-to-map SLAM on the robot,
 //! judged against ground truth; and the errors of the `slam` key.
 
 use crate::common::*;
@@ -78,7 +78,7 @@ fn slam_errors_name_the_key() {
     }
 }
 
-/// The maze experiment of 000_9f0113837c153763.txt (`sim experiment maze-slam`, maze only):
+/// The maze experiment of [Hospital thesis] (`sim experiment maze-slam`, maze only):
 /// DE scan-to-scan odometry drifts through the maze, while matching against the map —
 /// scan-to-map SLAM and the RBPF — does not; every method is judged at the same poses.
 #[test]

@@ -93,5 +93,4 @@ fn decode_front<T: DeserializeOwned>(bytes: &[u8]) -> Result<(T, usize, usize), 
 }
 
 #[cfg(test)]
-#[path = "cdr_tests.rs"]
 mod tests;

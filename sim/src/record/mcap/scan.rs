@@ -1,8 +1,8 @@
-//! The linear pass of [`super::reader`] over an MCAP file in memory (MCAP spec:
+//! The linear pass of the MCAP reader over an MCAP file in memory (MCAP spec:
 //! <https://mcap.dev/spec>, "Reading"): the `mcap` crate's sans-io linear reader with every CRC
 //! check on, the records collected into a [`McapRecording`], and its errors put in words.
 
-use super::reader::{Attachment, ChannelInfo, McapRecording, RecordedMessage};
+use super::recording::{Attachment, ChannelInfo, McapRecording, RecordedMessage};
 use mcap::McapError;
 use mcap::records::Record;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};

@@ -156,5 +156,4 @@ ros_message!(Range, "sensor_msgs", "std_msgs" Header, "builtin_interfaces" Time)
 ros_message!(JointState, "sensor_msgs", "std_msgs" Header, "builtin_interfaces" Time);
 
 #[cfg(test)]
-#[path = "schema_tests.rs"]
 mod tests;

@@ -5,8 +5,8 @@ mod fields;
 mod kinds;
 
 use super::error::KeyPath;
-use super::file::PointOrPlace;
-use super::resolve::{Checker, R};
+use super::check::PointOrPlace;
+use super::check::{Checker, R};
 use kinds::*;
 use serde::Deserialize;
 use std::f64::consts::PI;
@@ -389,7 +389,7 @@ pub(super) fn resolve_localizers(
         let lp = p.index(i);
         let name = match &l.name {
             Some(n) => {
-                if !super::resolve::check_name(n) {
+                if !super::check::check_name(n) {
                     return c.err(
                         &lp.key("name"),
                         format!("expected letters, digits, `_` or `-`, got `{n}`"),

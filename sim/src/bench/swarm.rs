@@ -1,0 +1,303 @@
+//! `sim bench swarm`: real-time factor and rays/s for swarms of wandering robots, each with a
+//! laser at 10 Hz, on the hospital map tiled 4 × 4 (so the swarm does not jam). Two lasers: Stage's
+//! benchmark ranger (180 beams over 180°, 8 m) and a SICK LMS100 (1081 beams over 270°, 20 m).
+
+use crate::options::check_duration;
+use crate::scenario::resolve::default_diff_drive;
+use crate::scenario::{RecordConfig, RobotConfig, Scenario, assets_dir};
+use crate::{RunOptions, run_scenario};
+use rand::RngExt;
+use serde::Serialize;
+use std::collections::{BTreeMap, HashMap};
+use systems::body::{Footprint, Kinematics};
+use systems::core::{Pose2, stream_rng};
+use systems::navigation::BehaviourKind;
+use systems::sensors::LaserSpec;
+use systems::world::{Cell, OccupancyGrid, load_map};
+
+/// `sim bench swarm`: real-time factor and rays/s for swarms of wandering robots with lasers at
+/// 10 Hz.
+#[derive(clap::Args, Clone, Debug)]
+pub struct SwarmOptions {
+    /// One JSON object per population and laser, one per line.
+    #[arg(long)]
+    pub json: bool,
+    /// Populations to run.
+    #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = [1usize, 10, 100, 1000])]
+    pub robots: Vec<usize>,
+    /// Beams per scan.
+    #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = [180usize, 1081])]
+    pub beams: Vec<usize>,
+    /// Simulated seconds per configuration.
+    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
+    pub duration: f64,
+    /// Worker threads (0 = one per core; at most 1024).
+    #[arg(long, default_value_t = 0, value_parser = crate::options::parse_threads)]
+    pub threads: usize,
+}
+
+#[derive(Serialize)]
+struct SwarmResult {
+    bench: &'static str,
+    robots: usize,
+    beams: usize,
+    fov_deg: f64,
+    max_range_m: f64,
+    laser_rate_hz: f64,
+    dt_s: f64,
+    threads: usize,
+    sim_time_s: f64,
+    wall_time_s: f64,
+    real_time_factor: f64,
+    rays_per_s: f64,
+    map: String,
+}
+
+/// The laser of a swarm robot with `beams` beams at 10 Hz.
+pub fn swarm_laser(beams: usize) -> LaserSpec {
+    let mut spec = if beams == 1081 {
+        LaserSpec::sick_lms100()
+    } else {
+        LaserSpec {
+            fov: std::f64::consts::PI,
+            increment: std::f64::consts::PI / (beams.max(2) - 1) as f64,
+            min_range: 0.1,
+            max_range: 8.0,
+            rate: 10.0,
+            noise_std: 0.01,
+            dropout: 0.0,
+            mount: Pose2::IDENTITY,
+        }
+    };
+    if beams != 1081 {
+        spec.increment = spec.fov / (beams.max(2) - 1) as f64;
+    }
+    spec.rate = 10.0;
+    spec
+}
+
+/// Least distance between two robots' starting points (m).
+const SPACING: f64 = 1.5;
+/// Placement gives up after this many random draws in a row that found no room.
+const MAX_MISSES: usize = 100_000;
+
+/// A swarm scenario: `n` wandering robots at random free places of `grid`, at least
+/// [`SPACING`] apart; an error if they do not fit.
+pub fn swarm_scenario(
+    grid: &OccupancyGrid,
+    n: usize,
+    beams: usize,
+    duration: f64,
+) -> anyhow::Result<Scenario> {
+    // a robot needs more than a square metre of free floor (discs of SPACING / 2 packed at best)
+    let free_m2 = grid.cells.iter().filter(|c| **c == Cell::Free).count() as f64
+        * grid.resolution
+        * grid.resolution;
+    if n as f64 > free_m2 {
+        anyhow::bail!(
+            "--robots {n}: the swarm map has {free_m2:.0} m² of free floor, and robots \
+             {SPACING} m apart need more than 1 m² each"
+        );
+    }
+    let mut rng = stream_rng(0, "swarm", "placement");
+    let b = grid.bounds();
+    let mut robots: Vec<RobotConfig> = Vec::with_capacity(n);
+    // robots by SPACING-sized bucket, so the spacing test looks at 3 × 3 buckets
+    let mut buckets: HashMap<(i64, i64), Vec<Pose2>> = HashMap::new();
+    let bucket = |x: f64, y: f64| ((x / SPACING).floor() as i64, (y / SPACING).floor() as i64);
+    let mut misses = 0;
+    while robots.len() < n {
+        if misses == MAX_MISSES {
+            anyhow::bail!(
+                "--robots {n}: only {} robots fit on the swarm map {SPACING} m apart \
+                 ({MAX_MISSES} random places in a row found no room)",
+                robots.len()
+            );
+        }
+        misses += 1;
+        let x = rng.random_range(b[0]..b[2]);
+        let y = rng.random_range(b[1]..b[3]);
+        let Some((c, r)) = grid.cell_of(x, y) else {
+            continue;
+        };
+        if !grid.disc_is_clear(x, y, 0.6) || grid.get(c, r) != Cell::Free {
+            continue;
+        }
+        let here = Pose2::new(x, y, 0.0);
+        let (bx, by) = bucket(x, y);
+        let crowded = (-1..=1).any(|dx| {
+            (-1..=1).any(|dy| {
+                buckets
+                    .get(&(bx + dx, by + dy))
+                    .is_some_and(|v| v.iter().any(|o| o.distance(&here) < SPACING))
+            })
+        });
+        if crowded {
+            continue;
+        }
+        misses = 0;
+        buckets.entry((bx, by)).or_default().push(here);
+        let theta = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+        robots.push(RobotConfig {
+            name: format!("r{:04}", robots.len()),
+            start: Pose2::new(x, y, theta),
+            footprint: Footprint::Circle { radius: 0.25 },
+            kinematics: Kinematics::DiffDrive(default_diff_drive()),
+            behaviour: BehaviourKind::Wander,
+            speed: 0.8,
+            tolerance: 0.4,
+            laser: Some(swarm_laser(beams)),
+            encoder: None,
+            sonar: None,
+            localizers: Vec::new(),
+            navigation: None,
+            gps: None,
+            compass: None,
+            camera: None,
+            route: None,
+        });
+    }
+    Ok(Scenario {
+        name: format!("swarm-{n}-{beams}"),
+        description: "benchmark swarm".into(),
+        seed: 0,
+        dt: 0.05,
+        duration,
+        source: "sim bench swarm".into(),
+        grid: grid.clone(),
+        places: BTreeMap::new(),
+        record: RecordConfig::default(),
+        robots,
+        events: Vec::new(),
+        doors: Vec::new(),
+        end_when_done: false,
+        people: Vec::new(),
+        roads: None,
+        zones: Vec::new(),
+    })
+}
+
+/// The benchmark world: the hospital tiled 4 × 4.
+pub fn swarm_world() -> anyhow::Result<OccupancyGrid> {
+    let path = assets_dir().join("maps/hospital/hospital.yaml");
+    let g = load_map(&path)?;
+    Ok(g.tiled(4, 4))
+}
+
+pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
+    check_duration(o.duration)?;
+    if let Some(n) = o.robots.iter().find(|n| **n == 0) {
+        anyhow::bail!("--robots: expected populations of at least 1 robot, got {n}");
+    }
+    let max = LaserSpec::MAX_BEAMS;
+    if let Some(b) = o.beams.iter().find(|b| !(2..=max).contains(*b)) {
+        anyhow::bail!("--beams: expected 2 to {max} beams per scan, got {b}");
+    }
+    let grid = swarm_world()?;
+    // every population is placed before the first one runs, so one that does not fit fails
+    // at once
+    let mut runs = Vec::with_capacity(o.beams.len() * o.robots.len());
+    for &beams in &o.beams {
+        for &n in &o.robots {
+            runs.push((beams, swarm_scenario(&grid, n, beams, o.duration)?));
+        }
+    }
+    let b = grid.bounds();
+    let map = format!(
+        "hospital tiled 4x4 ({:.0} x {:.0} m)",
+        b[2] - b[0],
+        b[3] - b[1]
+    );
+    if !o.json {
+        println!("swarm benchmark on {map}, lasers at 10 Hz, dt 0.05 s");
+        println!("machine: {}", crate::bench::machine::describe());
+        println!(
+            "{:>7} {:>6} {:>9} {:>10} {:>12} {:>14}",
+            "robots", "beams", "sim s", "wall s", "× real time", "rays/s"
+        );
+    }
+    for (beams, sc) in runs {
+        let spec = swarm_laser(beams);
+        let out = run_scenario(
+            &sc,
+            &RunOptions {
+                rrd: None,
+                threads: o.threads,
+                progress: false,
+                trajectory_period: None,
+            },
+        )?;
+        let s = &out.summary;
+        let scans_per_robot = (s.sim_time_s * spec.rate + 1e-9).floor() + 1.0;
+        let rays = sc.robots.len() as f64 * scans_per_robot * spec.beams() as f64;
+        let threads = if o.threads == 0 {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        } else {
+            o.threads
+        };
+        let r = SwarmResult {
+            bench: "swarm",
+            robots: sc.robots.len(),
+            beams: spec.beams(),
+            fov_deg: spec.fov.to_degrees(),
+            max_range_m: spec.max_range,
+            laser_rate_hz: spec.rate,
+            dt_s: sc.dt,
+            threads,
+            sim_time_s: s.sim_time_s,
+            wall_time_s: s.wall_time_s,
+            real_time_factor: s.real_time_factor,
+            rays_per_s: rays / s.wall_time_s.max(1e-9),
+            map: map.clone(),
+        };
+        if o.json {
+            println!("{}", crate::bench::machine::json_line(&r)?);
+        } else {
+            println!(
+                "{:>7} {:>6} {:>9.1} {:>10.2} {:>12.1} {:>14.3e}",
+                r.robots, r.beams, r.sim_time_s, r.wall_time_s, r.real_time_factor, r.rays_per_s
+            );
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 6 × 6 m room: its free middle holds a handful of robots 1.5 m apart, not 20.
+    fn room() -> OccupancyGrid {
+        let mut g = OccupancyGrid::new(120, 120, 0.05, [0.0, 0.0], Cell::Free);
+        for i in 0..120 {
+            for (c, r) in [(i, 0), (i, 119), (0, i), (119, i)] {
+                g.set(c, r, Cell::Occupied);
+            }
+        }
+        g
+    }
+
+    #[test]
+    fn robots_are_placed_apart_on_free_floor() {
+        let g = room();
+        let sc = swarm_scenario(&g, 6, 180, 1.0).expect("six robots fit");
+        assert_eq!(sc.robots.len(), 6);
+        for (i, a) in sc.robots.iter().enumerate() {
+            assert!(g.disc_is_clear(a.start.x, a.start.y, 0.6), "{:?}", a.start);
+            for b in &sc.robots[i + 1..] {
+                assert!(a.start.distance(&b.start) >= SPACING, "{a:?} {b:?}");
+            }
+        }
+        let again = swarm_scenario(&g, 6, 180, 1.0).expect("six robots fit");
+        let starts = |s: &Scenario| s.robots.iter().map(|r| r.start).collect::<Vec<_>>();
+        assert_eq!(starts(&sc), starts(&again), "placement is seeded");
+    }
+
+    #[test]
+    fn a_population_that_does_not_fit_is_an_error() {
+        let e = swarm_scenario(&room(), 20, 180, 1.0).expect_err("20 robots do not fit");
+        let e = e.to_string();
+        assert!(e.contains("--robots 20: only"), "{e}");
+        assert!(e.contains("fit on the swarm map"), "{e}");
+    }
+}

@@ -1,0 +1,341 @@
+//! World building: a validated scenario becomes an ECS world (resources, one entity per robot and
+//! one per walking person) and the tick schedule composed from the feature plugins of `systems`.
+
+pub mod outdoor;
+pub mod script;
+
+use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
+use crate::build::script::{EventQueue, fire_events};
+use bevy_ecs::prelude::*;
+use systems::body::{
+    DriveCommand, DriveState, Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics,
+    PhysicsPlugin, TruePose, TrueTwist, Walker,
+};
+use systems::core::{
+    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimRng, SimSet, new_schedule, stream_rng,
+};
+use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome, RobotMetrics};
+use systems::localization::de_filter::DeFilter;
+use systems::localization::de_mc::DeMc;
+use systems::localization::de_odometry::DeOdometry;
+use systems::localization::{
+    Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
+    NavSource, OdometryModel, ScanEstimator, WheelOdometry,
+};
+use systems::mapping::{GraphSlam, MappingPlugin, RbpfSlam, ScanToMapSlam};
+use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
+use systems::sensors::{
+    Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
+    SonarTruth, Sonars,
+};
+use systems::world::{Door, Doors, StaticWorld};
+
+/// A world ready to step.
+pub struct SimWorld {
+    pub world: World,
+    pub schedule: Schedule,
+    /// Robot entities in spawn (index) order.
+    pub robots: Vec<Entity>,
+    /// Walking people in spawn (index) order.
+    pub people: Vec<Entity>,
+}
+
+impl SimWorld {
+    /// One tick.
+    pub fn step(&mut self) {
+        self.schedule.run(&mut self.world);
+        self.world.resource_mut::<SimClock>().advance();
+    }
+
+    pub fn time(&self) -> f64 {
+        self.world.resource::<SimClock>().start()
+    }
+}
+
+/// What the world is built for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildMode {
+    /// A simulation: every plugin.
+    Live,
+    /// Estimators fed with recorded readings ([`crate::replay`]): the robots with their
+    /// sensors' descriptions, odometry, localizers and SLAM systems, the script and the
+    /// evaluation; no navigation, people, physics steps, sensor sampling or outdoor parts.
+    Replay,
+}
+
+/// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
+pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
+    build_world_with(scenario, threads, BuildMode::Live)
+}
+
+/// [`build_world`] for a live run or a replay.
+pub fn build_world_with(
+    scenario: &Scenario,
+    threads: usize,
+    mode: BuildMode,
+) -> anyhow::Result<SimWorld> {
+    let live = mode == BuildMode::Live;
+    let mut world = World::new();
+    let pool = KernelPool::new(threads)
+        .map_err(|e| anyhow::anyhow!("cannot start {threads} kernel threads: {e}"))?;
+    world.insert_resource(pool);
+    world.insert_resource(SimClock::new(scenario.dt));
+    let mut static_world = StaticWorld::new(scenario.grid.clone());
+    let mut physics = Physics::new(&mut static_world, scenario.dt);
+    // one shared costmap per distinct inflation setting of the robots with tasks
+    let nav_params: Vec<_> = scenario
+        .robots
+        .iter()
+        .filter(|_| live)
+        .filter_map(|r| r.navigation.as_ref().map(|n| n.costmap))
+        .collect();
+    let costmaps = (!nav_params.is_empty()).then(|| NavCostmaps::new(&static_world, &nav_params));
+    world.insert_resource(static_world);
+    world.insert_resource(Doors {
+        doors: scenario
+            .doors
+            .iter()
+            .map(|d| Door::new(d.name.clone(), d.from, d.to, d.thickness))
+            .collect(),
+    });
+    // the map localizers believe in: the floor plan as it is at the start
+    let any_localizer = scenario.robots.iter().any(|r| !r.localizers.is_empty());
+    let field_max_dist = scenario
+        .robots
+        .iter()
+        .flat_map(|r| r.localizers.iter().filter_map(|l| l.field_max_dist()))
+        .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))));
+    if any_localizer {
+        // DE localizers ray-cast only; the field is then small and unused
+        let max_dist = field_max_dist.unwrap_or(scenario.grid.resolution);
+        world.insert_resource(LocalizationMap::new(scenario.grid.clone(), max_dist));
+    }
+
+    if live {
+        crate::build::outdoor::insert_outdoor_world(&mut world, scenario);
+    }
+    let mut robots = Vec::with_capacity(scenario.robots.len());
+    for (i, r) in scenario.robots.iter().enumerate() {
+        let body = physics.add_robot(i as u32, &r.start, &r.footprint);
+        let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body)?;
+        if live {
+            crate::build::outdoor::insert_outdoor_parts(&mut world, scenario.seed, e, r);
+        }
+        if let (Some(nav), Some(maps)) = (&r.navigation, &costmaps) {
+            let mut params = nav.params.clone();
+            params.costmap = maps.index_of(&nav.costmap).unwrap_or(0);
+            let mut ent = world.entity_mut(e);
+            ent.remove::<Behaviour>();
+            ent.insert((
+                Navigator::new(params, nav.tasks.clone()),
+                NavOutcome::default(),
+            ));
+            if let Some(l) = nav.localizer {
+                ent.insert(NavSource::new(l));
+            }
+        }
+        robots.push(e);
+    }
+    let people = scenario
+        .people
+        .iter()
+        .enumerate()
+        .map(|(k, p)| spawn_person(&mut world, &mut physics, scenario.seed, k as u32, p))
+        .collect();
+    if let Some(maps) = costmaps {
+        world.insert_resource(maps);
+    }
+    world.insert_resource(physics);
+    world.insert_resource(EventQueue::new(
+        scenario.events.clone(),
+        &scenario.robots,
+        &robots,
+    ));
+
+    let mut schedule = new_schedule();
+    schedule.add_systems(fire_events.in_set(SimSet::Script));
+    let plugins: &[&dyn SimPlugin] = match mode {
+        BuildMode::Live => &[
+            &NavigationPlugin,
+            &PeoplePlugin,
+            &PhysicsPlugin,
+            &SensorsPlugin,
+            &LocalizationPlugin,
+            &MappingPlugin,
+            &EvalPlugin,
+        ],
+        BuildMode::Replay => &[&LocalizationPlugin, &MappingPlugin, &EvalPlugin],
+    };
+    for p in plugins {
+        p.build(&mut world, &mut schedule);
+    }
+    Ok(SimWorld {
+        world,
+        schedule,
+        robots,
+        people,
+    })
+}
+
+/// A walking person: a physics disc at its first route point, its script and walking state
+/// (random draws from its own `walk` stream).
+fn spawn_person(
+    world: &mut World,
+    physics: &mut Physics,
+    seed: u64,
+    index: u32,
+    p: &PersonConfig,
+) -> Entity {
+    let start = p.person.start_pose();
+    let body = physics.add_person(index, start.x, start.y, p.person.radius);
+    let walker = Walker::new(&p.person, stream_rng(seed, &p.name, "walk"));
+    world
+        .spawn((
+            PersonId(p.name.clone()),
+            PersonIndex(index),
+            p.person.clone(),
+            walker,
+            TruePose::at(start),
+            body,
+        ))
+        .id()
+}
+
+fn odometry_model(kin: &Kinematics, enc: &systems::sensors::EncoderSpec) -> OdometryModel {
+    match kin {
+        Kinematics::DiffDrive(d) => OdometryModel::DiffDrive {
+            left_radius: d.wheel_radius * (1.0 + enc.left_radius_error),
+            right_radius: d.wheel_radius * (1.0 + enc.right_radius_error),
+            wheel_base: d.wheel_base * (1.0 + enc.wheel_base_error),
+        },
+        Kinematics::Ackermann(a) => OdometryModel::Ackermann {
+            wheel_radius: a.wheel_radius * (1.0 + enc.left_radius_error),
+            wheelbase: a.wheelbase * (1.0 + enc.wheel_base_error),
+        },
+    }
+}
+
+fn spawn_robot(
+    world: &mut World,
+    seed: u64,
+    index: u32,
+    r: &RobotConfig,
+    body: systems::body::PhysicsBody,
+) -> anyhow::Result<Entity> {
+    let half_width = r.footprint.bounding_radius() + 0.1;
+    let mut behaviour = Behaviour::new(
+        r.behaviour.clone(),
+        r.speed,
+        half_width,
+        stream_rng(seed, &r.name, "behaviour"),
+    );
+    behaviour.tolerance = r.tolerance;
+    let mut e = world.spawn((
+        RobotId(r.name.clone()),
+        RobotIndex(index),
+        TruePose::at(r.start),
+        TrueTwist::default(),
+        r.footprint.clone(),
+        r.kinematics.clone(),
+        DriveCommand::default(),
+        DriveState::default(),
+        body,
+        behaviour,
+        NavBelief {
+            pose: r.start,
+            stamp: 0.0,
+        },
+        RobotMetrics::default(),
+    ));
+    if let Some(spec) = &r.laser {
+        e.insert((
+            Laser::new(spec.clone(), stream_rng(seed, &r.name, "laser")),
+            LaserScans::default(),
+            LaserTruth::default(),
+        ));
+    }
+    if let Some(spec) = &r.encoder {
+        e.insert((
+            Encoder::new(spec.clone(), stream_rng(seed, &r.name, "encoder")),
+            EncoderReadings::default(),
+            WheelOdometry::new(
+                odometry_model(&r.kinematics, spec),
+                spec.ticks_per_rev,
+                r.start,
+            ),
+        ));
+    }
+    if let Some(s) = &r.sonar {
+        e.insert((
+            Sonars::new(
+                s.spec.clone(),
+                s.mounts.clone(),
+                stream_rng(seed, &r.name, "sonar"),
+            ),
+            SonarReadings::default(),
+            SonarTruth::default(),
+        ));
+    }
+    let id = e.id();
+    if !r.localizers.is_empty() {
+        let items = {
+            let map = world.resource::<LocalizationMap>();
+            r.localizers
+                .iter()
+                .map(|l| {
+                    let rng = stream_rng(seed, &r.name, &format!("localizer/{}", l.name));
+                    Ok(Localizer::new(
+                        l.name.clone(),
+                        new_filter(&l.kind, Some(map), rng)?,
+                    ))
+                })
+                .collect::<anyhow::Result<_>>()?
+        };
+        world
+            .entity_mut(id)
+            .insert((Localizers { items }, LocalizationSamples::default()));
+    }
+    Ok(id)
+}
+
+/// The localizer or SLAM system a resolved scenario entry describes, with its random stream
+/// (`stream_rng(seed, robot, "localizer/<name>")`). Map-based localizers need the map they
+/// localize in; SLAM systems ([`Filter::Scan`]) take none.
+pub fn new_filter(
+    kind: &LocalizerKind,
+    map: Option<&LocalizationMap>,
+    rng: SimRng,
+) -> anyhow::Result<Filter> {
+    let need_map =
+        || map.ok_or_else(|| anyhow::anyhow!("a localizer of this type needs the scenario's map"));
+    Ok(match kind {
+        LocalizerKind::Mcl(c) => Filter::Mcl(Box::new(Mcl::new(c.clone(), need_map()?, rng))),
+        LocalizerKind::MarkovGrid(c) => {
+            Filter::MarkovGrid(Box::new(MarkovGrid::new(c.clone(), need_map()?)))
+        }
+        LocalizerKind::DeFilter(c) => {
+            Filter::DeFilter(Box::new(DeFilter::new(c.clone(), need_map()?, rng)))
+        }
+        LocalizerKind::DeMc(c) => Filter::DeMc(Box::new(DeMc::new(c.clone(), need_map()?, rng))),
+        LocalizerKind::DeOdometry(c) => {
+            Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
+        }
+        LocalizerKind::ScanToMap(c) => {
+            Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()).with_rng(rng)))
+        }
+        LocalizerKind::Graph(c) => Filter::Scan(Box::new(GraphSlam::new((**c).clone()))),
+        LocalizerKind::Rbpf(c) => Filter::Scan(Box::new(RbpfSlam::new((**c).clone(), rng))),
+    })
+}
+
+/// The SLAM system a resolved `slam` entry describes (an error for other localizer kinds).
+pub fn new_scan_estimator(
+    kind: &LocalizerKind,
+    rng: SimRng,
+) -> anyhow::Result<Box<dyn ScanEstimator>> {
+    match new_filter(kind, None, rng) {
+        Ok(Filter::Scan(e)) => Ok(e),
+        Ok(f) => anyhow::bail!("`{}` is a localizer, not a SLAM system", f.kind()),
+        Err(e) => Err(e),
+    }
+}

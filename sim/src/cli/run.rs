@@ -1,0 +1,68 @@
+//! `sim run`: its arguments and what it does with them.
+
+use crate::RunExports;
+use crate::options::check_duration;
+use crate::run::report::{OutputArgs, report_run};
+use crate::run::run_scenario_exporting;
+use crate::scenario::scenario_arg;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct RunArgs {
+    /// A scenario file or the name of a bundled scenario (default: hospital_patrol).
+    pub scenario: Option<String>,
+    /// Override the scenario's seed.
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Override the scenario's duration (simulated seconds).
+    #[arg(long, allow_negative_numbers = true)]
+    pub duration: Option<f64>,
+    #[command(flatten)]
+    pub out: OutputArgs,
+    /// Write the event log here: scenario events and navigation events (task started,
+    /// stops, re-plans, giving way, failures), one `time robot text` line each.
+    #[arg(long)]
+    pub log: Option<PathBuf>,
+    /// Export the run as a CARMEN log (ODOM, TRUEPOS, ROBOTLASER1) per robot with a laser and
+    /// encoders; several robots: `-<robot>` after the file's stem.
+    #[arg(long)]
+    pub carmen_out: Option<PathBuf>,
+    /// Also write an MCAP replay of the run (ROS 2 messages: scans, odometry, ground truth,
+    /// GPS, compass, camera, sonars, tf), for `sim replay` and ROS tools.
+    #[arg(long)]
+    pub mcap: Option<PathBuf>,
+}
+
+/// `sim run`.
+pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
+    let mut sc = scenario_arg(a.scenario.as_deref())?;
+    if let Some(s) = a.seed {
+        sc.seed = s;
+    }
+    if let Some(d) = a.duration {
+        sc.duration = check_duration(d)?;
+    }
+    let rrd_path = a
+        .out
+        .rrd_path(|| PathBuf::from(format!("{}-seed{}.rrd", sc.name, sc.seed)));
+    if !a.out.quiet {
+        eprintln!(
+            "running {} ({} robots, {:.1} s simulated, seed {})",
+            sc.name,
+            sc.robots.len(),
+            sc.duration,
+            sc.seed
+        );
+    }
+    let out = run_scenario_exporting(
+        &sc,
+        &a.out.run_options(rrd_path.clone()),
+        &RunExports {
+            carmen_out: a.carmen_out.clone(),
+            save_map: a.out.save_map.clone(),
+            mcap: a.mcap.clone(),
+        },
+    )?;
+    report_run(&out, &a.out.report(rrd_path.as_deref(), a.log.as_deref()))
+}
+

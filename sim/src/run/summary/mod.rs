@@ -1,0 +1,217 @@
+//! The run summary: printed as a table and written as JSON with `--summary`.
+
+pub mod collect;
+pub mod road;
+
+use serde::Serialize;
+use std::collections::BTreeMap;
+use systems::eval::LocalizerMetrics;
+
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct Summary {
+    pub scenario: String,
+    pub seed: u64,
+    pub sim_time_s: f64,
+    pub wall_time_s: f64,
+    pub real_time_factor: f64,
+    pub robots: Vec<RobotSummary>,
+}
+
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct RobotSummary {
+    pub name: String,
+    /// Ground-truth distance driven (m).
+    pub distance_m: f64,
+    /// Contact starts with walls, other robots and walking people.
+    pub collisions: u32,
+    pub wall_collisions: u32,
+    pub robot_collisions: u32,
+    pub person_collisions: u32,
+    /// Final wheel-odometry position error (m).
+    pub odometry_drift_m: f64,
+    pub max_odometry_drift_m: f64,
+    /// RMSE of the wheel odometry's position error over the run (its ATE, m).
+    pub odometry_ate_m: f64,
+    /// Final drift per distance driven (%).
+    pub odometry_drift_percent: f64,
+    pub odometry_heading_error_rad: f64,
+    pub waypoints_reached: u32,
+    /// The robot's route ended at its goal: the last waypoint of a waypoint route, or the goal
+    /// node of a road route.
+    pub route_completed: bool,
+    /// Final true pose [x, y, yaw].
+    pub final_pose: [f64; 3],
+    /// Accuracy of each localizer, by name.
+    pub localization: BTreeMap<String, LocalizerMetrics>,
+    /// Task-driven navigation outcomes (robots with tasks only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<NavigationSummary>,
+    /// Outdoor drive on the road network (robots with a route only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub road: Option<crate::run::summary::road::RoadSummary>,
+}
+
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct NavigationSummary {
+    pub tasks: u32,
+    pub tasks_completed: u32,
+    pub tasks_failed: u32,
+    /// Every task done or failed.
+    pub all_tasks_done: bool,
+    pub deliveries_completed: u32,
+    /// Each completed delivery, from taking the task to the end of unloading (s).
+    pub delivery_times_s: Vec<f64>,
+    pub mean_delivery_time_s: Option<f64>,
+    /// Legs (drives to a goal) completed.
+    pub legs: u32,
+    /// True distance driven on those legs (m) ...
+    pub path_length_m: f64,
+    /// ... against the A* optimum from the true start of each leg (m) ...
+    pub optimal_length_m: f64,
+    /// ... and their ratio.
+    pub path_ratio: Option<f64>,
+    /// Contact starts with walls and with other robots during the run.
+    pub collisions: u32,
+    pub wall_collisions: u32,
+    /// Stops for obstacles, and the time spent stopped or waiting aside (s).
+    pub stops: u32,
+    pub waiting_time_s: f64,
+    pub replans: u32,
+    /// Times the robot gave way to another robot.
+    pub yields: u32,
+    pub failures: Vec<NavigationFailure>,
+}
+
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct NavigationFailure {
+    pub time_s: f64,
+    pub task: String,
+    pub reason: String,
+}
+
+impl Summary {
+    /// The summary without its wall-clock fields (the part determinism guarantees).
+    pub fn deterministic_part(&self) -> Summary {
+        Summary {
+            wall_time_s: 0.0,
+            real_time_factor: 0.0,
+            ..self.clone()
+        }
+    }
+
+    /// A human-readable table.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "scenario {}  seed {}  simulated {:.1} s in {:.2} s ({:.1}× real time)\n",
+            self.scenario, self.seed, self.sim_time_s, self.wall_time_s, self.real_time_factor
+        );
+        s += &format!(
+            "{:<16} {:>11} {:>10} {:>6} {:>7} {:>7} {:>13} {:>8} {:>10}\n",
+            "robot",
+            "distance m",
+            "collisions",
+            "walls",
+            "robots",
+            "people",
+            "odom drift m",
+            "drift %",
+            "waypoints"
+        );
+        for r in &self.robots {
+            s += &format!(
+                "{:<16} {:>11.2} {:>10} {:>6} {:>7} {:>7} {:>13.3} {:>8.2} {:>10}\n",
+                r.name,
+                r.distance_m,
+                r.collisions,
+                r.wall_collisions,
+                r.robot_collisions,
+                r.person_collisions,
+                r.odometry_drift_m,
+                r.odometry_drift_percent,
+                r.waypoints_reached
+            );
+        }
+        let with_nav: Vec<(&str, &NavigationSummary)> = self
+            .robots
+            .iter()
+            .filter_map(|r| r.navigation.as_ref().map(|n| (r.name.as_str(), n)))
+            .collect();
+        if !with_nav.is_empty() {
+            s += &format!(
+                "\n{:<16} {:>7} {:>6} {:>11} {:>10} {:>9} {:>7} {:>6} {:>9} {:>8} {:>7}\n",
+                "robot",
+                "tasks",
+                "failed",
+                "deliveries",
+                "mean s",
+                "path m",
+                "ratio",
+                "stops",
+                "waited s",
+                "replans",
+                "yields"
+            );
+            for (name, n) in &with_nav {
+                s += &format!(
+                    "{:<16} {:>7} {:>6} {:>11} {:>10} {:>9.1} {:>7} {:>6} {:>9.1} {:>8} {:>7}\n",
+                    name,
+                    format!("{}/{}", n.tasks_completed, n.tasks),
+                    n.tasks_failed,
+                    n.deliveries_completed,
+                    n.mean_delivery_time_s
+                        .map_or("-".to_string(), |v| format!("{v:.1}")),
+                    n.path_length_m,
+                    n.path_ratio.map_or("-".to_string(), |v| format!("{v:.3}")),
+                    n.stops,
+                    n.waiting_time_s,
+                    n.replans,
+                    n.yields
+                );
+                for f in &n.failures {
+                    s += &format!(
+                        "  {name}: task {} failed at {:.1} s: {}\n",
+                        f.task, f.time_s, f.reason
+                    );
+                }
+            }
+        }
+        let with_loc: Vec<&RobotSummary> = self
+            .robots
+            .iter()
+            .filter(|r| !r.localization.is_empty())
+            .collect();
+        if !with_loc.is_empty() {
+            s += &format!(
+                "\n{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9}\n",
+                "robot",
+                "localizer",
+                "estimates",
+                "ATE m",
+                "RPE m",
+                "RPE rad",
+                "converged s",
+                "tracked %"
+            );
+            let opt = |v: Option<f64>, prec: usize| match v {
+                Some(v) => format!("{v:.prec$}"),
+                None => "-".to_string(),
+            };
+            for r in with_loc {
+                for (name, m) in &r.localization {
+                    s += &format!(
+                        "{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9}\n",
+                        r.name,
+                        name,
+                        m.estimates,
+                        opt(m.ate_rmse_m, 3),
+                        opt(m.rpe_trans_m, 4),
+                        opt(m.rpe_rot_rad, 4),
+                        opt(m.converged_after_s, 1),
+                        opt(m.tracked_fraction.map(|f| 100.0 * f), 1),
+                    );
+                }
+            }
+        }
+        s
+    }
+}
