@@ -1,6 +1,6 @@
 //! Camera on the park (assets/roads/park/park.osm): rendering one 320×240 frame from the
 //! rasterized road surface (0.05 m cells) on Basilica Avenue, the thesis's road recognition of
-//! one frame with learned colours (004_95e533f2514531b8.txt §5.2: rows bottom-up with step 2,
+//! one frame with learned colours ([Park thesis §5.2]: rows bottom-up with step 2,
 //! pixels from the centre out with step 4, one 64³ table read per pixel) of a rendered frame
 //! and of a frame whose pixels are computed as the recognizer reads them (what a run does),
 //! the road follower on the detection, and the one-off rasterization of the park.

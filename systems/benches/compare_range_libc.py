@@ -1,9 +1,10 @@
-"""range_libc on our hospital map, for the ray-casting comparison of README.md "Benchmarks".
+"""range_libc on our hospital map, for the ray-casting comparison of sim/docs/benchmarks.md,
+"Against range_libc".
 
-The issue that set our ray-casting targets quotes range_libc (Walsh & Karaman, "CDDT: Fast
-Approximate 2D Ray Casting for Accelerated Localization", ICRA 2018), the best C++ grid ray
-caster we know. This times it on the same machine, map and kind of queries as
-`cargo bench -p systems --bench raycast`, so the two can be compared on one day's hardware:
+range_libc ([Walsh 2018]: Walsh & Karaman, "CDDT: Fast Approximate 2D Ray Casting for Accelerated
+Localization", ICRA 2018) is the best C++ grid ray caster we know. This times it on the same
+machine, map and kind of queries as `cargo bench -p systems --bench raycast`, so the two can be
+compared on one day's hardware:
 
     python3 -m venv /tmp/rlc && /tmp/rlc/bin/pip install "cython<3" numpy setuptools wheel
     /tmp/rlc/bin/pip install --no-build-isolation pyrangelibc-danieldugas==0.0.2

@@ -1,4 +1,4 @@
-//! Loop-closure kernels (Cartographer's global SLAM, 001_6ab7973871dfdca6.txt).
+//! Loop-closure kernels (Cartographer's global SLAM [Hess 2016]; [SLAM thesis §3.3.2]).
 //!
 //! * `bnb/window_3m_30deg` — one branch-and-bound loop-closure query (Hess et al. 2016 §V):
 //!   a 1081-beam SICK LMS100 scan against a 30 × 30 m submap at 5 cm (a crop of the hospital

@@ -5,7 +5,7 @@
 //! * `improved` — one whole alignment by the improved matcher (±3 m, ±180°);
 //! * `thesis_de` — the thesis's DE (rand/1, binomial, population 20, F 0.5, CR 0.9, §7.2) with
 //!   the raster correlation fitness (eq. 29) for a fixed 200 generations (no early stop);
-//! * `fitness` — one evaluation of each fitness kernel of 000_9f0113837c153763.txt: the raster
+//! * `fitness` — one evaluation of each fitness kernel of the [Hospital thesis]: the raster
 //!   correlation (eq. 29), the Euclidean reference on a distance field (5 cm cells) and brute
 //!   force (§7.1); throughput is evaluations/s, over a fixed set of candidate transforms.
 //!

@@ -1,6 +1,6 @@
 //! Global planner on the hospital map (robot radius 0.3 m, inflation 1.0 m): A* plus
 //! line-of-sight shortening for fixed far-apart start/goal pairs across the building, one
-//! query per iteration with the scratch buffers reused, as a robot re-plans. Issue 4's target is
+//! query per iteration with the scratch buffers reused, as a robot re-plans. The target is
 //! under 20 ms per cross-building query. Also the costmap build from the static grid.
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};

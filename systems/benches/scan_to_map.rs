@@ -9,7 +9,7 @@
 //! * `pyramid/update_scan_cells` — `update_cells` with the cells under one scan's 1081 end
 //!   points (what a SLAM front end's hit updates touch).
 //!
-//! The target: scan-to-map SLAM at ≥ 50× real time with a 10 Hz laser on one core, a
+//! The target: scan-to-map SLAM at ≥ 50× real time with a 10 Hz laser on one core, a
 //! match plus map update well under 2 ms. `cargo bench -p systems --bench scan_to_map`.
 
 use criterion::{Criterion, criterion_group, criterion_main};

@@ -1,7 +1,7 @@
 //! The simulator's ECS vocabulary and every system, layered bottom-up:
 //! `core` ← `world` ← `raycast`/`body` ← `sensors` ← `matching` ← `localization` ←
 //! `mapping`/`navigation`/`eval`.
-//! Nothing lower imports anything higher (see ../shared/DESIGN.md).
+//! Nothing lower imports anything higher (see systems/ARCHITECTURE.md, "Layers of `systems`").
 //!
 //! Each feature folder exposes one [`core::schedule::SimPlugin`] that adds its systems to the
 //! right [`core::schedule::SimSet`]; the `sim` crate composes them from a scenario.

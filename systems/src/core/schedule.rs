@@ -1,4 +1,4 @@
-//! One tick, in order (../shared/DESIGN.md, "One tick"): Script, Plan, Control, Physics, Sense,
+//! One tick, in order (systems/ARCHITECTURE.md, "One tick"): Script, Plan, Control, Physics, Sense,
 //! Estimate, Map, Evaluate, Record. The schedule runs on bevy's single-threaded executor so the
 //! order of every system, and so every result, is deterministic; parallelism lives inside kernels.
 

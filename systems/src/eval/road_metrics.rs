@@ -1,4 +1,4 @@
-//! Outdoor runs judged against ground truth (the park experiments of 004_95e533f2514531b8.txt:
+//! Outdoor runs judged against ground truth (the park experiments of [Park thesis §7.3]:
 //! did the robot reach its goal, did it take a wrong turn and recover by re-localizing and
 //! re-planning, how far off was each road localizer along the way).
 //!
@@ -20,7 +20,7 @@ pub const MID_EDGE: f64 = 2.5;
 
 /// A run reached its goal when the navigator stopped with the robot truly this close to the
 /// goal node (m): the scale of the GPS error the road localization works with (most fixes
-/// 0.5–4 m off, 004_95e533f2514531b8.txt; SEEDS.md "GPS model").
+/// 0.5–4 m off, [Park thesis §5.3.3]).
 pub const REACHED_RADIUS: f64 = 5.0;
 
 /// Position error of one road localizer, at its updates.

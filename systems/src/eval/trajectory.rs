@@ -1,4 +1,5 @@
-//! Trajectory error metrics with the definitions of the evo tool (../shared/DESIGN.md, "Metrics"):
+//! Trajectory error metrics with the definitions of the evo tool (systems/ARCHITECTURE.md,
+//! "Metrics"; [Grupp 2017]):
 //!
 //! - ATE = `evo_ape tum TRUTH EST --align_origin`, translation RMSE: the estimate is moved by
 //!   the rigid transform that puts its first pose on the first true pose, then
@@ -6,7 +7,7 @@
 //! - RPE = `evo_rpe tum TRUTH EST --delta 1 --delta_unit f`: for consecutive pairs,
 //!   E_i = (Q_i⁻¹ Q_{i+1})⁻¹ (P_i⁻¹ P_{i+1}) with Q the truth and P the estimate; the mean of
 //!   ‖trans(E_i)‖ (`--pose_relation trans_part`) and of |angle(E_i)| (`angle_rad`), as in
-//!   Kümmerle et al. 2009 and 001_6ab7973871dfdca6.txt §5.
+//!   [Kümmerle 2009] and [SLAM thesis §4.3.1].
 //! - Tracking: a sample is tracked when its position error is under 0.2 m and its heading error
 //!   under 5° (map frame, no alignment). Global localization has converged at the first sample
 //!   from which every sample of the following `hold` seconds (or to the end of the run, if that

@@ -1,4 +1,4 @@
-//! The differential-evolution localization filter (000_9f0113837c153763.txt §3.9.1): Moreno,
+//! The differential-evolution localization filter ([Hospital thesis §3.9.1]): Moreno,
 //! Garrido & Muñoz, "Evolutionary filter for robust mobile robot global localization", RAS 54
 //! (2006), with the extensions of Martín, Muñoz, Garrido, Blanco & Moreno, "L1-norm global
 //! localization based on a differential evolution filter", WISP 2009.

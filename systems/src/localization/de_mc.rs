@@ -1,4 +1,4 @@
-//! Differential-evolution Markov-chain global localization (000_9f0113837c153763.txt §3.9.2,
+//! Differential-evolution Markov-chain global localization ([Hospital thesis §3.9.2],
 //! algorithm DE_MC_GL; Martín, Moreno, Garrido & Blanco, "Kullback-Leibler divergence-based
 //! differential evolution Markov chain filter for global localization of mobile robots",
 //! Sensors 15 (2015); the sampler is ter Braak's DE-MC, Statistics and Computing 16 (2006)).

@@ -1,5 +1,5 @@
 //! Scan-to-scan odometry with the DE scan matcher, as in the maze experiment of
-//! 000_9f0113837c153763.txt (§7.4: the pose follows from matching consecutive scans, errors
+//! the [Hospital thesis] (§6.2: the pose follows from matching consecutive scans, errors
 //! accumulate by integration). Each update matches the current scan against the last keyframe
 //! scan; the wheel odometry since the keyframe is the initial guess: the current points are
 //! pre-moved by it and the matcher searches only a small window around it (`matcher.window`,

@@ -1,6 +1,4 @@
-//! What the two DE localizers share (000_9f0113837c153763.txt §3.9; Moreno, Garrido & Muñoz,
-//! "Evolutionary filter for robust mobile robot global localization", RAS 2006; Martín et al.,
-//! "L1-norm global localization based on a differential evolution filter", WISP 2009): a
+//! What the two DE localizers share ([Hospital thesis §3.9]; [Moreno 2006]; [Martín 2009]): a
 //! population of poses, its cost against the map — the L1 or L2 distance between the measured
 //! ranges of a beam subset and the ranges ray-cast from the member's sensor pose, per beam — the
 //! motion of the population by odometry between scans, and the estimate (best member, with the

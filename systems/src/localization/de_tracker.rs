@@ -1,5 +1,5 @@
 //! The update cycle both DE localizers share ([`super::de_filter`], [`super::de_mc`];
-//! 000_9f0113837c153763.txt §3.9): move the population by odometry, score it on the new scan,
+//! [Hospital thesis §3.9]): move the population by odometry, score it on the new scan,
 //! refine the best member locally, let the method evolve the population, keep the elite, update
 //! the convergence state and the estimate; once a converged filter is lost, a fresh population
 //! spread over the whole floor searches again.

@@ -61,8 +61,9 @@ mod tests {
     use bevy_ecs::prelude::*;
     use bevy_ecs::system::SystemAccess;
 
-    /// The rule of ../shared/DESIGN.md: estimators never read ground truth. Their systems'
-    /// declared world access (what bevy lets them touch) contains no ground-truth component.
+    /// The rule of systems/ARCHITECTURE.md, "Ground truth and belief": estimators never read
+    /// ground truth. Their systems' declared world access (what bevy lets them touch) contains
+    /// no ground-truth component.
     #[test]
     fn localization_systems_never_read_ground_truth() {
         let mut world = World::new();

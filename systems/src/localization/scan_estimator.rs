@@ -2,7 +2,7 @@
 //! same laser scans and wheel odometry as the localizers, through one interface. They sit in a
 //! robot's [`super::Localizers`] as [`super::Filter::Scan`], so their estimates are published,
 //! evaluated (ATE/RPE), summarised and recorded exactly like a localizer's; their scans are fed
-//! in the Map set of the tick, after the localizers (DESIGN.md, tick order).
+//! in the Map set of the tick, after the localizers (systems/ARCHITECTURE.md, "One tick").
 
 use super::mcl::PoseEstimate;
 use crate::core::Pose2;

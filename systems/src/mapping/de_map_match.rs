@@ -1,11 +1,10 @@
-//! The DE matcher of the localization issue as the alternative matcher of scan-to-map SLAM
-//! (issue 5, item 2): differential evolution (Storn & Price 1997; 000_9f0113837c153763.txt §4,
-//! [`crate::matching::de::minimize`]) searches a window around the odometry prediction for the
-//! pose minimising Hector SLAM's objective Σ (1 − M(Tₚ(sᵢ)))² (Kohlbrecher et al., SSRR 2011,
-//! eq. 6; M the map's bilinearly interpolated occupancy, [`crate::matching::map_pyramid`]) plus
-//! the odometry prior's quadratic term — the objective Gauss-Newton descends, searched
-//! globally within the window instead of by gradient, as the thesis proposes for its maze drift
-//! ("match each scan against the map built so far").
+//! The scan matcher's DE as the alternative matcher of scan-to-map SLAM: differential evolution
+//! ([Storn 1997]; [Hospital thesis §5.1], [`crate::matching::de::minimize`]) searches a window
+//! around the odometry prediction for the pose minimising Hector SLAM's objective
+//! Σ (1 − M(Tₚ(sᵢ)))² (Kohlbrecher et al., SSRR 2011, eq. 6; M the map's bilinearly interpolated
+//! occupancy, [`crate::matching::map_pyramid`]) plus the odometry prior's quadratic term — the
+//! objective Gauss-Newton descends, searched globally within the window instead of by gradient, as
+//! the thesis proposes for its maze drift (match each scan against the map built so far).
 
 use crate::core::moments::weighted_scatter;
 use crate::core::{Pose2, SimRng, wrap_angle};

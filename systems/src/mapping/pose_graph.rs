@@ -1,5 +1,5 @@
-//! Sparse pose adjustment on SE(2): the back end of graph-based SLAM (001_6ab7973871dfdca6.txt:
-//! "global SLAM: sparse pose adjustment with Huber loss").
+//! Sparse pose adjustment on SE(2): the back end of graph-based SLAM ([SLAM thesis §3.3.2]:
+//! Cartographer's global SLAM, sparse pose adjustment with a Huber loss).
 //!
 //! Sources: K. Konolige, G. Grisetti, R. Kümmerle, W. Burgard, B. Limketkai, R. Vincent,
 //! "Efficient Sparse Pose Adjustment for 2D Mapping", IROS 2010 (SPA: the 2-D error function and

@@ -1,5 +1,5 @@
-//! Map quality against a ground-truth map, issue 5 item 6: "fraction of occupied cells within one
-//! cell of a true wall and of true walls covered, after aligning the map frames".
+//! Map quality against a ground-truth map: the fraction of occupied cells within one cell of a
+//! true wall and of true walls covered, after aligning the map frames.
 //!
 //! Definitions (both maps are [`OccupancyGrid`]s; threshold a [`crate::matching::ProbGrid`] with
 //! its `to_occupancy`). `est_to_truth` is the rigid transform taking a point of the estimated

@@ -1,12 +1,11 @@
-//! Scan-to-map SLAM in the spirit of Hector SLAM (Kohlbrecher et al., SSRR 2011, §IV): every
-//! scan is matched by Gauss-Newton against the map built so far (a multi-resolution pyramid),
-//! and inserted into it once the robot has moved far enough. This is the fix 000_9f0113837c153763
-//! proposes for its scan-to-scan drift (SEEDS.md, maze experiment: "match each scan against the
-//! map built so far").
+//! Scan-to-map SLAM in the spirit of Hector SLAM (Kohlbrecher et al., SSRR 2011, §IV): every scan
+//! is matched by Gauss-Newton against the map built so far (a multi-resolution pyramid), and
+//! inserted into it once the robot has moved far enough. This is the fix the [Hospital thesis]
+//! proposes for its scan-to-scan drift (§6.2, §8: match each scan against the map built so far).
 //!
 //! Unlike Hector, which has no odometry, the wheel odometry predicts each match's starting guess
 //! and (optionally) pulls the result towards it with a prior whose spread grows with the motion
-//! since the last scan, so a featureless corridor — where Hector gets lost (001_6ab7973871dfdca6,
+//! since the last scan, so a featureless corridor — where Hector gets lost ([SLAM thesis §4.3.3],
 //! MIT corridor) — leaves the estimate on the odometry along the corridor axis instead of
 //! sliding. The map frame is the world frame: the SLAM starts at the robot's known start pose.
 

@@ -1,4 +1,4 @@
-//! Mapping the simulated hospital with known poses (issue 5, acceptance test 11): SICK LMS100
+//! Mapping the simulated hospital with known poses: SICK LMS100
 //! scans ray-cast on the true map along the corridors, inserted at their true poses, must give a
 //! map whose walls lie on true walls and cover the true walls the robot saw (both > 95 %).
 

@@ -1,6 +1,6 @@
 //! Real-time correlative scan matching by branch-and-bound: the loop-closure matcher of
-//! Cartographer (001_6ab7973871dfdca6.txt, "Cartographer: … loop closure by branch-and-bound scan
-//! matching over a search window with a minimum score threshold").
+//! Cartographer ([SLAM thesis §3.3.2]: loop closure by branch-and-bound scan matching over a
+//! search window with a minimum score threshold).
 //!
 //! Sources: W. Hess, D. Kohler, H. Rapp, D. Andor, "Real-Time Loop Closure in 2D LIDAR SLAM",
 //! ICRA 2016, §V; E. Olson, "Real-time correlative scan matching", ICRA 2009 (exhaustive search

@@ -1,5 +1,5 @@
-//! The thesis's fitness: cross-correlation of rasterised scans, 000_9f0113837c153763.txt §5.2
-//! eq. 29 and §6 eqs. 31–32.
+//! The thesis's fitness: cross-correlation of rasterised scans, [Hospital thesis §5.2, eq. 29]
+//! and [Hospital thesis §6, eqs. 31–32].
 //!
 //! Both point sets (eq. 28) are scaled into a square binary "correlation map" of `cells × cells`
 //! over `[−half_extent, half_extent)²` metres around the reference sensor (the thesis: 100 cells

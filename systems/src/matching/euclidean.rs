@@ -1,5 +1,5 @@
 //! The thesis's reference fitness — sum of minimum Euclidean distances — in its brute-force form
-//! (000_9f0113837c153763.txt §7.1, the pseudo-code "Sumační minimální euklidovská vzdálenost"),
+//! ([Hospital thesis §7.1], the pseudo-code "Sumační minimální euklidovská vzdálenost"),
 //! and a fast form on a precomputed distance field.
 //!
 //! **Brute force** ([`euclidean_brute`]), exactly as §7.1 describes it: move the current scan B

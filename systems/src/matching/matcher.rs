@@ -1,6 +1,6 @@
 //! The scan-matcher entry point: find the rigid transform `p = (p_x, p_y, ω)` that moves the
 //! CURRENT scan's points into the REFERENCE scan's frame, `b ↦ R(ω) b + (p_x, p_y)`
-//! (000_9f0113837c153763.txt §5: "nalézt afinní transformaci p, která nejlépe spojí testovací
+//! ([Hospital thesis §5]: "nalézt afinní transformaci p, která nejlépe spojí testovací
 //! snímek s referenčním"). If the current scan was taken at pose `P_cur` and the reference at
 //! `P_ref`, the answer is `P_ref⁻¹ ⊕ P_cur` (`Pose2::between`).
 //!

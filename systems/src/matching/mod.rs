@@ -1,6 +1,6 @@
-//! Scan-matching kernels shared by localization and mapping (see ../shared/DESIGN.md): the
-//! differential-evolution scan matcher of 000_9f0113837c153763.txt and its fitness functions,
-//! plus an improved matcher built from the same ideas.
+//! Scan-matching kernels shared by localization and mapping (systems/ARCHITECTURE.md, "Layers of
+//! `systems`"): the differential-evolution scan matcher of the [Hospital thesis] and its fitness
+//! functions, plus an improved matcher built from the same ideas.
 //!
 //! Entry point: [`match_scans`]`(reference, current, &MatchConfig) -> MatchResult`, which finds
 //! the transform `(x, y, θ)` moving the current scan's points into the reference scan's frame.

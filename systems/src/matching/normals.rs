@@ -1,7 +1,7 @@
 //! Surface normals of scan points: principal-component analysis of the few neighbouring beams
 //! around each point, kept only where the neighbourhood is a thin line. This is the normal
 //! estimate of point-to-line ICP (Censi, "An ICP variant using a point-to-line metric", ICRA 2008)
-//! and of the line-based methods surveyed in 000_9f0113837c153763.txt §3 (CLS, HSM); the
+//! and of the line-based methods surveyed in [Hospital thesis §3.5, §3.7] (CLS, HSM); the
 //! improved matcher uses the normals for its rotation pre-search ([`super::orientation`]) and
 //! for point-to-line refinement ([`super::refine`]).
 //!

@@ -1,6 +1,6 @@
 //! Rotation pre-search by cross-correlating orientation histograms of surface normals, the
-//! "histogram correlation" method the thesis surveys (000_9f0113837c153763.txt §3.8, after
-//! Weiß & von Puttkamer [15]): `c(j) = Σ_i h₁(i) · h₂((i + j) mod n)`. The angle histogram does
+//! "histogram correlation" method the thesis surveys ([Hospital thesis §3.8, eq. 12]; angle
+//! histograms after [Weiß 1994]): `c(j) = Σ_i h₁(i) · h₂((i + j) mod n)`. The angle histogram does
 //! not depend on translation, so its correlation peaks give rotation hypotheses before any
 //! translation is known.
 //!

@@ -5,7 +5,7 @@
 //! * [`ScoreGrid`] — for every cell centre within `radius` of a reference point, a score
 //!   `255 · (1 − d²/radius²)` of the distance `d` to the nearest one. It is the smooth
 //!   correlation surface of the coarse searches: a soft version of the binary correlation map of
-//!   000_9f0113837c153763.txt §5.2 eq. 29 (a point scores by how close it lands to the reference
+//!   [Hospital thesis §5.2, eq. 29] (a point scores by how close it lands to the reference
 //!   outline instead of whether it shares a 0.2 m cell with it), as in Olson's correlative scan
 //!   matching ("Real-time correlative scan matching", ICRA 2009).
 //! * [`NearestGrid`] — for every cell centre within `radius` of a reference point, the index of

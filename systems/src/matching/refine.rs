@@ -1,7 +1,7 @@
 //! Local refinement of a transform by point-to-line ICP solved with Gauss–Newton (Censi,
 //! "An ICP variant using a point-to-line metric", ICRA 2008; Chen & Medioni 1992): the final
 //! step of the improved matcher, which polishes the coarse hypothesis the way the thesis's DE
-//! polishes its best member over thousands of generations (000_9f0113837c153763.txt §6), but in
+//! polishes its best member over thousands of generations ([Hospital thesis §6]), but in
 //! a handful of iterations.
 //!
 //! Each iteration moves the current points by the estimate, looks their nearest reference point

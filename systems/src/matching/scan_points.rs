@@ -1,4 +1,4 @@
-//! Laser scan → Cartesian points in the sensor frame, eq. 28 of 000_9f0113837c153763.txt (§5.2):
+//! Laser scan → Cartesian points in the sensor frame ([Hospital thesis §5.2, eq. 28]):
 //! `(x, y) = (r(Φ) cos Φ, r(Φ) sin Φ)` with `Φ = angle_min + k · angle_increment` (ROS
 //! `sensor_msgs/LaserScan` convention). Readings that are not finite (+Inf = no return, −Inf =
 //! below the minimum range, NaN = invalid, REP 117) or outside `[range_min, range_max]` are

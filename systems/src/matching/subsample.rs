@@ -3,7 +3,7 @@
 //! thin evenly to at most `max` points. Near the sensor a scan is far denser than far away (the
 //! beams fan out), so this evens out the weight of near and far surfaces and cuts the cost of
 //! every evaluation; cf. the voxel filters of Censi's PLICP and of Cartographer. The thesis
-//! itself (000_9f0113837c153763.txt §6) rasterises every point.
+//! itself ([Hospital thesis §6]) rasterises every point.
 
 /// Points at least `spacing` apart along the scan, at most `max` of them (every k-th after
 /// spacing if there are more). Order is kept.

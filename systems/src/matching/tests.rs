@@ -114,7 +114,7 @@ pub(super) fn close(found: &Pose2, truth: &Pose2, xy: f64, theta: f64) -> bool {
 }
 
 /// A reference pose in a hospital room from which the thesis's example transform
-/// (−911 mm, 2579 mm, −57°, 000_9f0113837c153763.txt §6) lands on a free, visible pose.
+/// (−911 mm, 2579 mm, −57°, [Hospital thesis §6]) lands on a free, visible pose.
 fn thesis_example_pair() -> (Pose2, Pose2) {
     let t = Pose2::new(-0.911, 2.579, (-57f64).to_radians());
     let b = hospital().grid.bounds();

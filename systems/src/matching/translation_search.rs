@@ -1,7 +1,7 @@
 //! Exhaustive translation search for a fixed rotation on the reference score grid
 //! ([`super::ref_grid::ScoreGrid`]): the brute-force correlation over shifts of Olson's
 //! correlative scan matcher (ICRA 2009), i.e. the thesis's raster cross-correlation
-//! (000_9f0113837c153763.txt §5.2 eq. 29) evaluated over a whole lattice of shifts instead of
+//! ([Hospital thesis §5.2, eq. 29]) evaluated over a whole lattice of shifts instead of
 //! sampled by DE.
 //!
 //! The rotated current points are quantised to grid cells once; a shift by whole cells `(i, k)`

@@ -4,7 +4,7 @@
 //! of view), but never well *in front of* what the reference measured along the same bearing.
 //! Counting such violations separates a right alignment from a wrong one that happens to lay
 //! many points on some other, similar wall — the "chybné natočení" (wrong rotation) and
-//! symmetric-room failures of 000_9f0113837c153763.txt §6.2 and §7.3, which its correlation
+//! symmetric-room failures of [Hospital thesis §6.2, §7.3], which its correlation
 //! fitness cannot see. (The same negative information is what beam models in Probabilistic
 //! Robotics §6.3 use.)
 //!

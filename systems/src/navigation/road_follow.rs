@@ -1,7 +1,7 @@
-//! Road following by the camera (004_95e533f2514531b8.txt §5.4, SEEDS.md "Driving": the robot
-//! follows the road it recognizes in the image; at a junction it keeps to the left or right road
-//! edge when the next road is the leftmost or rightmost). Steering is pure pursuit (R. C.
-//! Coulter, CMU-RI-TR-92-01, 1992) towards a point of the recognized road: κ = 2·y / L².
+//! Road following by the camera ([Park thesis §5.5]: the robot follows the road it recognizes in
+//! the image; at a junction it keeps to the left or right road edge when the next road is the
+//! leftmost or rightmost). Steering is pure pursuit (R. C. Coulter, CMU-RI-TR-92-01, 1992) towards
+//! a point of the recognized road: κ = 2·y / L².
 //!
 //! 1. Each detected row ([`RoadDetection`]) becomes ground points in the robot frame through
 //!    the camera's pinhole model ([`CameraSpec::ground_point`]). A level camera maps an image

@@ -1,6 +1,6 @@
-//! Route planning on the road graph (004_95e533f2514531b8.txt, SEEDS.md "Planning"): A* with
-//! edge length as cost and the straight-line distance to the goal as heuristic, and the thesis's
-//! no-U-turn rule for a car-like robot — the node behind the robot is unreachable from the start.
+//! Route planning on the road graph ([Park thesis §5.4]): A* with edge length as cost and the
+//! straight-line distance to the goal as heuristic, and the thesis's no-U-turn rule for a car-like
+//! robot — the node behind the robot is unreachable from the start.
 //!
 //! The rule is enforced everywhere, not only at the start: the search runs over *directed*
 //! edges (u → v), and from (u → v) it may continue on any edge at v except straight back to u.

@@ -1,4 +1,4 @@
-//! Robot tasks as a hospital logistics system hands them out (000_9f0113837c153763.txt: the
+//! Robot tasks as a hospital logistics system hands them out ([Hospital thesis §1]: the
 //! robot loads at the pharmacy, drives to a ward, waits to be unloaded and returns): a queue of
 //! deliveries, trips and waits per robot, each expanded into steps the navigator executes in
 //! order.

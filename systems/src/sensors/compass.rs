@@ -1,11 +1,12 @@
-//! Tilt-compensated compass (004_95e533f2514531b8.txt: CMPS09; SEEDS.md "GPS accuracy": off by
+//! Tilt-compensated compass ([Park thesis §4.1.2]: CMPS09; [Park thesis §5.3.1]: off by
 //! under 1° in the open, by 8–20° near electromagnetic interference). A reading is the true
 //! heading as a compass azimuth (clockwise from north; magnetic north is taken as true north)
 //! plus a constant bias, Gaussian noise and the deflection of the interference zone the robot is
 //! in ([`crate::world::Zones`]). Recorded like the orientation of a sensor_msgs/Imu: a reading
 //! carries that quaternion and its azimuth is computed from it, so a replay that rebuilds the
 //! reading from a recorded message ([`CompassReading::from_orientation`]) gets the same azimuth
-//! bit for bit (DESIGN.md: estimators consume readings shaped like their ROS messages).
+//! bit for bit (systems/ARCHITECTURE.md, "File formats": estimators consume readings shaped
+//! like their ROS messages).
 
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;

@@ -3,7 +3,7 @@
 //! perturbed by slip noise; readings are cumulative quadrature tick counts at the encoder's own
 //! rate. Calibration errors (relative errors of the left/right wheel radius and of the wheel base
 //! that odometry assumes) make odometry curve away from the truth, like the robot of
-//! 001_6ab7973871dfdca6.txt that drifted right; 004_95e533f2514531b8.txt measured distance errors
+//! [SLAM thesis §4.3.4] that drifted right; the [Park thesis] (§5.3.3) measured distance errors
 //! of 0.31–1.06 % after calibration. An Ackermann robot has one drive-shaft encoder (both counts
 //! equal) and reports its steering angle.
 

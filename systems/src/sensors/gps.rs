@@ -1,5 +1,6 @@
-//! GPS receiver (004_95e533f2514531b8.txt: LS20031, 1–10 Hz, cold start under 35 s, hot start
-//! under 2 s; SEEDS.md "GPS accuracy", "GPS model"). A fix is the true antenna position plus
+//! GPS receiver ([Park thesis §4.1.2]: LS20031, 1–10 Hz, cold start under 35 s, hot start
+//! under 2 s; accuracy and error model: [Park thesis §5.3.1, §5.3.3]). A fix is the true
+//! antenna position plus
 //!
 //! - a **bias**, a first-order Gauss–Markov process per axis (stationary σ `bias_std`, time
 //!   constant `bias_tau`), so the mean of many fixes can sit metres off the truth as the thesis

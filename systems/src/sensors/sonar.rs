@@ -1,6 +1,6 @@
-//! Ultrasonic range sensors (sonars), modelled on the Devantech SRF02 of the outdoor robot in
-//! seed 004 (4 × SRF02: one straight ahead, two at ±45°, one at the back; "sonars guard against
-//! collisions", sec. 4.1.2 and 5.5). All of a robot's sonars fire together at the spec's rate.
+//! Ultrasonic range sensors (sonars), modelled on the Devantech SRF02 of the outdoor robot of
+//! the [Park thesis] (§4.1.2, §5.5: 4 × SRF02: one straight ahead, two at ±45°, one at the back;
+//! they guard against collisions). All of a robot's sonars fire together at the spec's rate.
 //!
 //! A sonar reports the range of the nearest echo inside its beam. The beam is modelled as a fan of
 //! rays spread evenly across the cone (at most [`MAX_RAY_SPACING`] apart, both edges included),
@@ -47,9 +47,10 @@ impl SonarSpec {
     /// Specification"): range 15 cm – 6 m; results in whole centimetres (srf02techI2C.htm: range
     /// registers in inches, cm or µs) → 1 cm resolution; "the ranging lasts up to 65 mS" → at most
     /// ~15 readings per second. Beam: Devantech's 40 kHz beam pattern is ~55° wide (its SRF04
-    /// pattern, which the SRF235 page quotes as "the 55° typical pattern"; seed 004 reproduces the
-    /// SRF02 plot in Obr. 5b and notes the beam is not wide, hence three front sensors). The
-    /// datasheet gives no noise figure: 1 cm (1σ), the seed's "accuracy of mm to cm" (sec. 2.4).
+    /// pattern, which the SRF235 page quotes as "the 55° typical pattern"; the [Park thesis]
+    /// (§4.1.2, fig. 5b) reproduces the SRF02 plot and notes the beam is not wide, hence three
+    /// front sensors). The datasheet gives no noise figure: 1 cm (1σ), the "accuracy of mm to
+    /// cm" of [Park thesis §2.4].
     pub fn srf02() -> Self {
         SonarSpec {
             cone: 55f64.to_radians(),
@@ -388,7 +389,7 @@ mod tests {
             assert!((m.x.hypot(m.y) - 0.3).abs() < 1e-12);
             assert!((m.theta - yaw).abs() < 1e-12);
         }
-        // the seed's 520 × 400 mm chassis
+        // the [Park thesis] car's 520 × 400 mm chassis
         let r = edge_mounts(
             &Footprint::Rectangle {
                 length: 0.52,
@@ -402,7 +403,8 @@ mod tests {
         assert!((r[3].x + 0.26).abs() < 1e-12);
     }
 
-    /// Robot 0 at the origin facing +x with the seed's four sonars; robot 1 a disc ahead.
+    /// Robot 0 at the origin facing +x with the four sonars of the [Park thesis] car; robot 1 a
+    /// disc ahead.
     fn run_world(threads: usize, seed: u64, ticks: usize) -> Vec<(f64, Vec<f32>)> {
         let mut world = World::new();
         world.insert_resource(KernelPool::new(threads).unwrap());

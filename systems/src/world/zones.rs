@@ -1,8 +1,8 @@
-//! Outdoor zones that degrade GPS and compass readings (004_95e533f2514531b8.txt, SEEDS.md "GPS
-//! accuracy"): in the open the thesis's receiver sat within about 1.25 m on average, under
-//! partial tree cover up to 5.85 m and between buildings up to 6.31 m off (the *mean* fix, so the
-//! error has a slow bias, not only noise), and its compass was off by under 1° except near
-//! electromagnetic interference, where it was off by 8–20°.
+//! Outdoor zones that degrade GPS and compass readings ([Park thesis §5.3.1]): in the open the
+//! thesis's receiver sat within about 1.25 m on average, under partial tree cover up to 5.85 m and
+//! between buildings up to 6.31 m off (the *mean* fix, so the error has a slow bias, not only
+//! noise), and its compass was off by under 1° except near electromagnetic interference, where it
+//! was off by 8–20°.
 //!
 //! A zone is a polygon or a circle in local metres with a kind that sets default parameters
 //! ([`ZoneKind::gps`], [`ZoneKind::compass`]); a scenario may override them per zone. Where zones

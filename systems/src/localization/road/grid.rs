@@ -1,6 +1,6 @@
-//! Road-grid localization, the thesis's localizer (004_95e533f2514531b8.txt §5.3.2 "Lokalizace
-//! na mřížce", §5.3.3, §5.5; ../shared/SEEDS.md "Grid localization"): a Bayes filter over a
-//! 1-D grid of 2 m cells laid along candidate road edges (code listing 5.3).
+//! Road-grid localization, the thesis's localizer ([Park thesis §5.3.2 "Lokalizace na mřížce",
+//! §5.3.3, §5.5]): a Bayes filter over a 1-D grid of 2 m cells laid along candidate road edges
+//! (code listing 5.3).
 //!
 //! - **Candidates** (§5.5, first step): the directed edges within `candidate_radius` (10–30 m
 //!   "depending on the environment"; 20 m) of the first GPS fix whose azimuth matches the

@@ -1,6 +1,6 @@
 //! The hot kernels of the road localizers, plain functions over slices: the grid's motion
 //! (a Gaussian integrated over 2 m cells), its Bayes correction and acceptance test
-//! (004_95e533f2514531b8.txt §5.3.2, §5.5), and the MCL's effective sample size and
+//! ([Park thesis §5.3.2, §5.5]), and the MCL's effective sample size and
 //! low-variance resampling (Probabilistic Robotics Table 4.4).
 
 /// Standard normal CDF Φ(x), by the complementary error function of Numerical Recipes

@@ -1,5 +1,5 @@
 //! Monte Carlo localization on the road graph: the state space of the thesis's road grid
-//! (004_95e533f2514531b8.txt §5.3.2, §5.5: a directed edge and the distance along it) sampled
+//! ([Park thesis §5.3.2, §5.5]: a directed edge and the distance along it) sampled
 //! by particles instead of 2 m cells (Probabilistic Robotics Table 8.2), so that the failure
 //! the thesis reports in §7.2.3 — a 40 m GPS error in the first fix localized the robot on the
 //! wrong road — can be recovered from:

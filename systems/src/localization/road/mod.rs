@@ -1,6 +1,5 @@
-//! Localization on the road graph: where on which road, driving which way, from the
-//! drive-shaft encoder, GPS fixes and the compass (004_95e533f2514531b8.txt §5.3 "Lokalizace",
-//! §5.5 "Proces navigace"; ../shared/SEEDS.md "004_95e533f2514531b8.txt").
+//! Localization on the road graph: where on which road, driving which way, from the drive-shaft
+//! encoder, GPS fixes and the compass ([Park thesis §5.3 "Lokalizace", §5.5 "Proces navigace"]).
 //!
 //! - [`grid`]: the thesis's road-grid localization, a Bayes filter over 2 m cells along
 //!   candidate edges (§5.3.2, §5.3.3, §5.5);

@@ -2,7 +2,7 @@
 //! 0.2 s steps; the encoder reads 1 % long (the worst calibrated error of the thesis's Tab. 3),
 //! a GPS fix comes every 1 s from the simulator's error model (LN(1, 0.506) in a random
 //! direction, small Gauss–Markov bias, no random outliers), and the compass reads the heading of
-//! the edge driven with 1° of noise (004_95e533f2514531b8.txt §5.3.1, SEEDS.md).
+//! the edge driven with 1° of noise ([Park thesis §5.3.1]).
 
 use super::{DirEdge, RoadObservation};
 use crate::core::SimRng;

@@ -1,6 +1,6 @@
 //! Loop-closure constraints between a node and a finished submap (Hess et al., "Real-Time Loop
-//! Closure in 2D LIDAR SLAM", ICRA 2016, §V; 001_6ab7973871dfdca6.txt: Cartographer's loop
-//! closure by branch-and-bound scan matching over a search window with a minimum score).
+//! Closure in 2D LIDAR SLAM", ICRA 2016 ([Hess 2016, §V]); [SLAM thesis §3.3.2]: Cartographer's
+//! loop closure by branch-and-bound scan matching over a search window with a minimum score).
 //!
 //! The node's scan is searched for by [`match_bnb`] over a window around its current global
 //! estimate (expressed in the submap's local coordinates); a match that reaches `min_score` is
@@ -115,7 +115,7 @@ pub fn search(
 /// by −`anchor_theta`, plus `floor`² per axis so no constraint claims more precision than
 /// that. Along a featureless corridor the match covariance is huge, so the constraint holds
 /// the pose across the corridor and leaves it free along it — the corridor aliasing that makes
-/// Hector slide (001_6ab7973871dfdca6.txt) cannot drag the graph.
+/// Hector slide ([SLAM thesis §4.3.3]) cannot drag the graph.
 fn information(cov: &[[f64; 3]; 3], anchor_theta: f64, floor: &[f64; 3]) -> [[f64; 3]; 3] {
     let (s, c) = anchor_theta.sin_cos();
     let j = [[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]];

@@ -1,6 +1,6 @@
 //! Graph SLAM in the spirit of Cartographer (W. Hess, D. Kohler, H. Rapp, D. Andor, "Real-Time
-//! Loop Closure in 2D LIDAR SLAM", ICRA 2016; 001_6ab7973871dfdca6.txt, which finds its loop
-//! closure the most accurate of the three systems it compares on large data).
+//! Loop Closure in 2D LIDAR SLAM", ICRA 2016 ([Hess 2016]); [SLAM thesis §4.3.3], which finds
+//! its loop closure the most accurate of the three systems it compares on large data).
 //!
 //! * Local SLAM (§IV): every scan is tracked by the scan-to-map step of
 //!   [`super::scan_to_map`] (odometry prediction, Gauss-Newton against a pyramid, odometry

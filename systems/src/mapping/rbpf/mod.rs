@@ -1,7 +1,7 @@
 //! Rao-Blackwellized particle filter SLAM in the spirit of GMapping (G. Grisetti, C. Stachniss,
 //! W. Burgard, "Improved Techniques for Grid Mapping with Rao-Blackwellized Particle Filters",
-//! IEEE T-RO 23(1), 2007; 001_6ab7973871dfdca6.txt, SEEDS.md "GMapping"), with the parameters
-//! that seed studies under their GMapping names (`particles`, `linearUpdate`, `angularUpdate`,
+//! IEEE T-RO 23(1), 2007 ([Grisetti 2007]); [SLAM thesis §3.1, §5.1]), with the parameters
+//! that thesis studies under their GMapping names (`particles`, `linearUpdate`, `angularUpdate`,
 //! `llsamplerange`, `llsamplestep`, `lasamplerange`, `lasamplestep`) and its defaults.
 //!
 //! Each particle carries a pose, a weight and its own occupancy map ([`tile_map`], tiles shared
@@ -82,7 +82,7 @@ pub struct RbpfConfig {
 }
 
 impl Default for RbpfConfig {
-    /// The values 001_6ab7973871dfdca6.txt lists (GMapping's ROS defaults) where it lists them.
+    /// The values [SLAM thesis §5.1] lists (GMapping's ROS defaults) where it lists them.
     fn default() -> Self {
         RbpfConfig {
             particles: 30,

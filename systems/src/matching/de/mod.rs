@@ -1,5 +1,5 @@
 //! Differential evolution (Storn & Price 1995) over 3-D vectors `(x, y, θ)` in a box, as
-//! 000_9f0113837c153763.txt §5.1 describes it and its C++ program (§6) runs it:
+//! [Hospital thesis §5.1] describes it and its C++ program (§6) runs it:
 //!
 //! * initial generation `P₀`: `NP` members drawn uniformly in the box (§6 "inicializace");
 //! * for every member `xᵢ` a mutant `u` by one of the nine strategies, eqs. 19–27 (below), then a
@@ -48,7 +48,8 @@
 //! budget, when the best cost has improved by no more than a tolerance over K generations
 //! (stall), when every member lies within a tolerance of the best on every axis (collapse), or
 //! when a wall-time limit is reached. The wall-time limit breaks determinism: use it only
-//! outside the simulation schedule (e.g. the CLI), never inside it (DESIGN.md).
+//! outside the simulation schedule (e.g. the CLI), never inside it (systems/ARCHITECTURE.md,
+//! "Determinism").
 
 use super::error::MatchError;
 use crate::core::SimRng;

@@ -1,5 +1,5 @@
 //! The improved matcher: the thesis's idea — score a candidate transform by how well the moved
-//! current scan overlaps the reference (000_9f0113837c153763.txt §5.2, eq. 29) and search the
+//! current scan overlaps the reference ([Hospital thesis §5.2, eq. 29]) and search the
 //! transforms globally — rebuilt to be both right and fast, with DE kept as the global fallback.
 //! The thesis's failure modes shape it (§6.2, §7.3, §8): DE stagnates in local optima, the
 //! correlation mis-rotates scans, and symmetric rooms and corridors fool it. So rotations are

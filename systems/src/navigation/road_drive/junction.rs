@@ -1,9 +1,9 @@
-//! How to drive through a junction (004_95e533f2514531b8.txt, SEEDS.md "Driving"): at a node
-//! with more than two neighbours the robot keeps to the left road edge when the next road is the
-//! leftmost of the roads leaving the node, to the right edge when it is the rightmost, and
-//! otherwise steers by the compass towards the next road's azimuth. Following an edge of the
-//! road round the junction takes the outermost branch without knowing the junction's geometry
-//! exactly, which the GPS cannot give to a metre.
+//! How to drive through a junction ([Park thesis §5.5]): at a node with more than two neighbours
+//! the robot keeps to the left road edge when the next road is the leftmost of the roads leaving
+//! the node, to the right edge when it is the rightmost, and otherwise steers by the compass
+//! towards the next road's azimuth. Following an edge of the road round the junction takes the
+//! outermost branch without knowing the junction's geometry exactly, which the GPS cannot give to a
+//! metre.
 
 use crate::core::wrap_angle;
 use crate::world::roads::{EdgeId, NodeId, RoadGraph};

@@ -1,10 +1,10 @@
-//! Driving to a goal on the road network (004_95e533f2514531b8.txt, SEEDS.md "Planning" and
-//! "Driving"): the road localization's belief (a directed edge and the distance left on it) is
-//! checked against the planned route; when it is not on the route — at the start, or after a
-//! wrong turn the localization has noticed — the A* road planner plans again from there, never
-//! with a U-turn. Between junctions the camera's road follower steers; approaching a junction
-//! the robot keeps to the left or right road edge or steers by the compass ([`junction`]); the
-//! front sonars stop it before obstacles. Everything here reads the belief and the sensors only.
+//! Driving to a goal on the road network ([Park thesis §5.4, §5.5]): the road localization's belief
+//! (a directed edge and the distance left on it) is checked against the planned route; when it is
+//! not on the route — at the start, or after a wrong turn the localization has noticed — the A*
+//! road planner plans again from there, never with a U-turn. Between junctions the camera's road
+//! follower steers; approaching a junction the robot keeps to the left or right road edge or steers
+//! by the compass ([`junction`]); the front sonars stop it before obstacles. Everything here reads
+//! the belief and the sensors only.
 
 pub mod junction;
 pub mod system;

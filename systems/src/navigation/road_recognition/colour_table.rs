@@ -1,5 +1,5 @@
-//! The learned road colours (004_95e533f2514531b8.txt §5.2, SEEDS.md "Camera road
-//! recognition"): colours are compared in HSV by the thesis's weighted distance
+//! The learned road colours ([Park thesis §5.2]): colours are compared in HSV by the thesis's
+//! weighted distance
 //!
 //! ΔE = √((H_e − H_l)² + (S_e − S_l)²/4 + (V_e − V_l)²/16)
 //!

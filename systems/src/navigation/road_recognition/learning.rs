@@ -1,7 +1,6 @@
-//! Learning the road colours (004_95e533f2514531b8.txt, SEEDS.md "Camera road recognition"):
-//! from the learning window in the first frames, as the thesis does, and — beyond it — again
-//! for a road of a new surface, guarded by the background colours seen beside the road so a
-//! robot standing on the grass never learns grass as road.
+//! Learning the road colours ([Park thesis §5.2]): from the learning window in the first frames, as
+//! the thesis does, and — beyond it — again for a road of a new surface, guarded by the background
+//! colours seen beside the road so a robot standing on the grass never learns grass as road.
 
 use super::{BACKGROUND_COLOURS, RELEARN_BUDGET, RoadDetection, RoadRecognizer};
 use crate::sensors::camera::Pixels;

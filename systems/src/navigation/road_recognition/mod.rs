@@ -1,5 +1,4 @@
-//! Road recognition in the camera image (004_95e533f2514531b8.txt §5.2, SEEDS.md "Camera road
-//! recognition"), after the thesis:
+//! Road recognition in the camera image ([Park thesis §5.2]), after the thesis:
 //!
 //! - **Learning**: the road colours are learned from the first `learn_frames` frames, from a
 //!   window at the bottom centre of the image that the robot, set down on a road, sees as road

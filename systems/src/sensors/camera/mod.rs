@@ -1,8 +1,8 @@
-//! Forward-looking colour camera over the road surface (004_95e533f2514531b8.txt §4, §5.2;
-//! SEEDS.md "Camera road recognition": a USB camera, 640×480 frames halved to 320×240 for the
-//! road recognition). An ideal pinhole camera (no lens distortion) at `mount_height` above the
-//! flat ground, `mount_x` ahead of the robot origin, looking forward and pitched down by
-//! `pitch`; it sees the rasterized road surface ([`RoadSurface`]) and sky above the horizon.
+//! Forward-looking colour camera over the road surface ([Park thesis §4.1.2, §5.2]: a USB camera,
+//! 640×480 frames halved to 320×240 for the road recognition). An ideal pinhole camera (no lens
+//! distortion) at `mount_height` above the flat ground, `mount_x` ahead of the robot origin,
+//! looking forward and pitched down by `pitch`; it sees the rasterized road surface
+//! ([`RoadSurface`]) and sky above the horizon.
 //!
 //! Pinhole model: focal length f = (width / 2) / tan(hfov / 2) pixels, principal point at the
 //! image centre, square pixels; pixel (u, v) is a continuous position (u right, v down; pixel

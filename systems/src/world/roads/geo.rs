@@ -2,8 +2,7 @@
 //! tangent plane around a reference point is exact enough: the equirectangular projection
 //! x = R·cos φ₀·(λ − λ₀), y = R·(φ − φ₀) (x east, y north, the simulator's world frame). Over
 //! 500 m its distances differ from the haversine distance by under 0.01 % (about 2 cm), less
-//! than any GPS error. R = 6 378.135 km, the radius the haversine of 004_95e533f2514531b8.txt
-//! uses (SEEDS.md, "GPS accuracy").
+//! than any GPS error. R = 6 378.135 km, the radius of the haversine in [Park thesis §5.3.1].
 
 /// Earth radius of the thesis's haversine (m).
 pub const EARTH_RADIUS_M: f64 = 6_378_135.0;

@@ -1,6 +1,6 @@
 //! GPX 1.1 (and 1.0): every track segment `trk/trkseg/trkpt` and every route `rte/rtept` is a
 //! road; the track's `<name>` names it and its `<type>` gives the surface. The thesis reduced
-//! the OpenStreetMap export of its park to such tracks (004_95e533f2514531b8.txt).
+//! the OpenStreetMap export of its park to such tracks ([Park thesis §5.1]).
 
 use super::{RawRoads, Road, RoadError, RoadOptions, Source, Surface, default_width};
 

@@ -1,7 +1,7 @@
 //! The road graph and the road surface it carries: nodes in local metres, straight edges with
 //! length and compass azimuth, each edge belonging to a road (an OSM way or a GPX track) that
 //! gives its surface type and width. The graph is what the planner and the road-grid
-//! localization walk (004_95e533f2514531b8.txt: "a graph of points and road segments"); the
+//! localization walk ([Park thesis §5.1]: a graph of points and road segments); the
 //! edges widened to their road's width are the road surface the camera sees and off-road
 //! detection tests against.
 

@@ -1,4 +1,4 @@
-//! Road networks for outdoor navigation (004_95e533f2514531b8.txt, SEEDS.md "Map"): OSM XML
+//! Road networks for outdoor navigation ([Park thesis §5.1]): OSM XML
 //! (nodes and ways with `highway=*`, their `surface` and `width` tags) and GPX 1.1 tracks
 //! (`trk/trkseg/trkpt`, also `rte/rtept`), read with `roxmltree`, projected to local metres
 //! ([`geo`]) and turned into a [`RoadGraph`].

@@ -1,7 +1,7 @@
-//! The road surface as the camera sees it (004_95e533f2514531b8.txt §5.2, SEEDS.md
-//! "Camera road recognition": the robot tells road from its surroundings by colour): the road
-//! graph's edges widened to their road's width and rasterized once into a grid of surface
-//! classes, which the camera renderer ([`crate::sensors::camera`]) looks up per pixel.
+//! The road surface as the camera sees it ([Park thesis §5.2]: the robot tells road from its
+//! surroundings by colour): the road graph's edges widened to their road's width and rasterized
+//! once into a grid of surface classes, which the camera renderer ([`crate::sensors::camera`])
+//! looks up per pixel.
 //!
 //! - Each edge is a capsule (a segment with round ends) of half its road's width, so bends and
 //!   junctions join without gaps.

@@ -1,8 +1,7 @@
 //! The camera's render kernel: every pixel below the horizon looks up the road surface under
 //! its ground ray (pinhole model, [`super::GroundRays`]) and becomes that surface's colour;
 //! pixels above the horizon are sky. Colours imitate a park in daylight as the thesis's USB
-//! camera saw it (004_95e533f2514531b8.txt §5.2: grey asphalt and light gravel among green
-//! grass; SEEDS.md "Camera road recognition").
+//! camera saw it ([Park thesis §5.2]: grey asphalt and light gravel among green grass).
 //!
 //! Texture, so the recognizer does not face flat colours:
 //! - **mottle**: a value-noise pattern fixed to the ground (hashes of the raster cell at 0.4 m
