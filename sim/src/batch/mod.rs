@@ -19,10 +19,10 @@ pub mod sets;
 pub use args::BatchArgs;
 
 use crate::options::check_duration;
-use crate::scenario::scenario_path;
+use crate::run::summary::Summary;
 use crate::run::{RunOptions, run_scenario};
 use crate::scenario::Scenario;
-use crate::run::summary::Summary;
+use crate::scenario::scenario_path;
 use output::Row;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

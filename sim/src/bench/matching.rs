@@ -7,8 +7,8 @@
 //! time is the cost of 20 020 fitness evaluations).
 
 use crate::experiment::de_match::{MAX_XY_M, PERIOD_S, STEPS, check_pairs, thesis_de};
-use crate::experiment::scan_pairs::{LMS100_BEAMS, bundled, capture, draw_pairs};
 use crate::experiment::match_pair::TransformError;
+use crate::experiment::scan_pairs::{LMS100_BEAMS, bundled, capture, draw_pairs};
 use crate::stats::{median, quantile};
 use serde::Serialize;
 use systems::core::stream_rng;

@@ -6,8 +6,8 @@
 //! the files.
 
 use crate::options::check_duration;
-use crate::scenario::scenario_arg;
 use crate::run::{RunOptions, run_scenario_exporting};
+use crate::scenario::scenario_arg;
 use crate::{RunExports, stats};
 use serde::Serialize;
 use std::path::{Path, PathBuf};

@@ -10,8 +10,8 @@
 use crate::build::new_scan_estimator;
 use crate::experiment::scan_pairs::bundled;
 use crate::experiment::slam_compare::{SlamExperimentOptions, simulate};
-use crate::scenario::slam_file::resolve_slam_config;
 use crate::log_slam::feed::feed_scans;
+use crate::scenario::slam_file::resolve_slam_config;
 use crate::stats::{median, quantile};
 use serde::Serialize;
 use systems::core::{KernelPool, stream_rng};

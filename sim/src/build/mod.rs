@@ -4,8 +4,8 @@
 pub mod outdoor;
 pub mod script;
 
-use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
 use crate::build::script::{EventQueue, fire_events};
+use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
 use bevy_ecs::prelude::*;
 use systems::body::{
     DriveCommand, DriveState, Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics,

@@ -65,4 +65,3 @@ pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
     )?;
     report_run(&out, &a.out.report(rrd_path.as_deref(), a.log.as_deref()))
 }
-

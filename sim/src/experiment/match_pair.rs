@@ -132,7 +132,11 @@ pub struct MatchOptions {
     #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
     pub max_xy: f64,
     /// Search window: |θ| <= this (degrees).
-    #[arg(long = "max-theta", default_value_t = 180.0, allow_negative_numbers = true)]
+    #[arg(
+        long = "max-theta",
+        default_value_t = 180.0,
+        allow_negative_numbers = true
+    )]
     pub max_theta_deg: f64,
     /// Seed of the matcher's random stream.
     #[arg(long, default_value_t = 0)]

@@ -6,9 +6,9 @@
 //! single-threaded and deterministic, so the table does not depend on the thread count.
 
 use super::scan_pairs::bundled;
+use crate::run::summary::road::RoadSummary;
 use crate::scenario::Scenario;
 use crate::scenario::outdoor_robot::RoadLocalizerKind;
-use crate::run::summary::road::RoadSummary;
 use crate::{RunOptions, run_scenario};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -191,7 +191,8 @@ fn row(route: &str, by: &str, seeds: u64, runs: &[&ParkRun]) -> ParkRow {
         .filter_map(|r| r.road.arrival_time_s)
         .collect();
     let loc =
-        |name: &str, f: &dyn Fn(&crate::run::summary::road::RoadLocalizerSummary) -> Option<f64>| {
+        |name: &str,
+         f: &dyn Fn(&crate::run::summary::road::RoadLocalizerSummary) -> Option<f64>| {
             mean(
                 runs.iter()
                     .filter_map(|r| r.road.localizers.get(name))

@@ -21,10 +21,10 @@
 use super::scan_pairs::bundled;
 use crate::build::new_scan_estimator;
 use crate::formats::carmen::{CarmenReadOptions, ScanRecord, read_carmen};
-use crate::scenario::Scenario;
-use crate::scenario::slam_file::resolve_slam_config;
 use crate::log_slam::eval::TruthTrack;
 use crate::log_slam::feed::feed_scans;
+use crate::scenario::Scenario;
+use crate::scenario::slam_file::resolve_slam_config;
 use crate::{RunExports, RunOptions, run_scenario_exporting};
 use serde::Serialize;
 use systems::core::{KernelPool, Pose2, stream_rng};

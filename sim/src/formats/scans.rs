@@ -221,6 +221,59 @@ pub fn parse_scans<R: Read>(input: R, name: &str) -> Result<Vec<ScanRecord>, Sca
         }
         Some(r) => r.map_err(csv_error)?,
     };
+    check_header(&header, &err)?;
+
+    let mut scans = Vec::new();
+    let mut seen: HashMap<u64, u64> = HashMap::new();
+    for rec in records {
+        let rec = rec.map_err(csv_error)?;
+        let line = rec.position().map_or(0, |p| p.line());
+        // a blank line (csv skips truly empty ones; a line of spaces is one empty field)
+        if rec.len() == 1 && rec.get(0).is_some_and(|f| f.trim().is_empty()) {
+            continue;
+        }
+        if rec.len() <= FIXED {
+            return Err(err(
+                line,
+                None,
+                None,
+                format!(
+                    "expected at least {} fields ({} fixed fields and one range per beam), found {}",
+                    FIXED + 1,
+                    FIXED,
+                    rec.len()
+                ),
+            ));
+        }
+        let (index, scan) = parse_row(&rec, line, &err)?;
+        if let Some(first) = seen.insert(index, line) {
+            return Err(err(
+                line,
+                Some(1),
+                Some("index".into()),
+                format!(
+                    "expected a unique scan index, found {index} again (first on line {first})"
+                ),
+            ));
+        }
+        scans.push(scan);
+    }
+    if scans.is_empty() {
+        return Err(err(
+            0,
+            None,
+            None,
+            "expected at least one scan after the header line, found none".into(),
+        ));
+    }
+    Ok(scans)
+}
+
+/// The error of a line: (line, column, field, message).
+type LineError<'a> = dyn Fn(u64, Option<usize>, Option<String>, String) -> ScansError + 'a;
+
+/// Checks the header line against [`SCANS_HEADER`].
+fn check_header(header: &csv::StringRecord, err: &LineError) -> Result<(), ScansError> {
     for (i, want) in SCANS_HEADER.iter().enumerate() {
         match header.get(i) {
             Some(got) if got.trim() == *want => {}
@@ -260,111 +313,89 @@ pub fn parse_scans<R: Read>(input: R, name: &str) -> Result<Vec<ScanRecord>, Sca
             ),
         ));
     }
+    Ok(())
+}
 
-    let mut scans = Vec::new();
-    let mut seen: HashMap<u64, u64> = HashMap::new();
-    for rec in records {
-        let rec = rec.map_err(csv_error)?;
-        let line = rec.position().map_or(0, |p| p.line());
-        // a blank line (csv skips truly empty ones; a line of spaces is one empty field)
-        if rec.len() == 1 && rec.get(0).is_some_and(|f| f.trim().is_empty()) {
-            continue;
-        }
-        if rec.len() <= FIXED {
-            return Err(err(
-                line,
-                None,
-                None,
-                format!(
-                    "expected at least {} fields ({} fixed fields and one range per beam), found {}",
-                    FIXED + 1,
-                    FIXED,
-                    rec.len()
-                ),
-            ));
-        }
-        let field = |i: usize| rec.get(i).unwrap_or("").trim();
-        let bad = |i: usize, what: &str| {
+/// One scan line (at least [`FIXED`] + 1 fields): its index and the scan.
+fn parse_row(
+    rec: &csv::StringRecord,
+    line: u64,
+    err: &LineError,
+) -> Result<(u64, ScanRecord), ScansError> {
+    let field = |i: usize| rec.get(i).unwrap_or("").trim();
+    let bad = |i: usize, what: &str| {
+        err(
+            line,
+            Some(i + 1),
+            Some(SCANS_HEADER[i.min(FIXED)].to_string()),
+            format!("expected {what}, found `{}`", field(i)),
+        )
+    };
+    let index: u64 = field(0)
+        .parse()
+        .map_err(|_| bad(0, "a non-negative integer"))?;
+    let robot = field(1).to_string();
+    if robot.is_empty() {
+        return Err(bad(1, "a robot name"));
+    }
+    let finite64 = |i: usize| -> Result<f64, ScansError> {
+        field(i)
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(i, "a finite number"))
+    };
+    let finite32 = |i: usize| -> Result<f32, ScansError> {
+        field(i)
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(i, "a finite number"))
+    };
+    let stamp = finite64(2)?;
+    let (x, y, theta) = (finite64(3)?, finite64(4)?, finite64(5)?);
+    let angle_min = finite32(6)?;
+    let angle_increment = finite32(7)?;
+    if angle_increment == 0.0 {
+        return Err(bad(7, "a non-zero angle between beams (rad)"));
+    }
+    let range_min = finite32(8)?;
+    if range_min < 0.0 {
+        return Err(bad(8, "a minimum range >= 0 m"));
+    }
+    let range_max = finite32(9)?;
+    if range_max <= range_min {
+        return Err(bad(
+            9,
+            &format!("a maximum range greater than range_min = {range_min} m"),
+        ));
+    }
+    let mut ranges = Vec::with_capacity(rec.len() - FIXED);
+    for i in FIXED..rec.len() {
+        let text = field(i);
+        let r: f32 = text.parse().map_err(|_| {
             err(
                 line,
                 Some(i + 1),
-                Some(SCANS_HEADER[i.min(FIXED)].to_string()),
-                format!("expected {what}, found `{}`", field(i)),
+                Some(format!("ranges[{}]", i - FIXED)),
+                format!(
+                    "expected a range in metres (a number, `inf`, `-inf` or `nan`), found `{text}`"
+                ),
             )
-        };
-        let index: u64 = field(0)
-            .parse()
-            .map_err(|_| bad(0, "a non-negative integer"))?;
-        if let Some(first) = seen.insert(index, line) {
+        })?;
+        if r.is_finite() && r < 0.0 {
             return Err(err(
                 line,
-                Some(1),
-                Some("index".into()),
-                format!(
-                    "expected a unique scan index, found {index} again (first on line {first})"
-                ),
+                Some(i + 1),
+                Some(format!("ranges[{}]", i - FIXED)),
+                format!("expected a range >= 0 m (or `inf`, `-inf`, `nan`), found `{text}`"),
             ));
         }
-        let robot = field(1).to_string();
-        if robot.is_empty() {
-            return Err(bad(1, "a robot name"));
-        }
-        let finite64 = |i: usize| -> Result<f64, ScansError> {
-            field(i)
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| bad(i, "a finite number"))
-        };
-        let finite32 = |i: usize| -> Result<f32, ScansError> {
-            field(i)
-                .parse::<f32>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| bad(i, "a finite number"))
-        };
-        let stamp = finite64(2)?;
-        let (x, y, theta) = (finite64(3)?, finite64(4)?, finite64(5)?);
-        let angle_min = finite32(6)?;
-        let angle_increment = finite32(7)?;
-        if angle_increment == 0.0 {
-            return Err(bad(7, "a non-zero angle between beams (rad)"));
-        }
-        let range_min = finite32(8)?;
-        if range_min < 0.0 {
-            return Err(bad(8, "a minimum range >= 0 m"));
-        }
-        let range_max = finite32(9)?;
-        if range_max <= range_min {
-            return Err(bad(
-                9,
-                &format!("a maximum range greater than range_min = {range_min} m"),
-            ));
-        }
-        let mut ranges = Vec::with_capacity(rec.len() - FIXED);
-        for i in FIXED..rec.len() {
-            let text = field(i);
-            let r: f32 = text.parse().map_err(|_| {
-                err(
-                    line,
-                    Some(i + 1),
-                    Some(format!("ranges[{}]", i - FIXED)),
-                    format!(
-                        "expected a range in metres (a number, `inf`, `-inf` or `nan`), found `{text}`"
-                    ),
-                )
-            })?;
-            if r.is_finite() && r < 0.0 {
-                return Err(err(
-                    line,
-                    Some(i + 1),
-                    Some(format!("ranges[{}]", i - FIXED)),
-                    format!("expected a range >= 0 m (or `inf`, `-inf`, `nan`), found `{text}`"),
-                ));
-            }
-            ranges.push(r);
-        }
-        scans.push(ScanRecord {
+        ranges.push(r);
+    }
+    Ok((
+        index,
+        ScanRecord {
             index,
             robot,
             stamp,
@@ -374,17 +405,8 @@ pub fn parse_scans<R: Read>(input: R, name: &str) -> Result<Vec<ScanRecord>, Sca
             range_min,
             range_max,
             ranges,
-        });
-    }
-    if scans.is_empty() {
-        return Err(err(
-            0,
-            None,
-            None,
-            "expected at least one scan after the header line, found none".into(),
-        ));
-    }
-    Ok(scans)
+        },
+    ))
 }
 
 #[cfg(test)]

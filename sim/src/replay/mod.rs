@@ -32,8 +32,8 @@ pub use source::{RobotFeed, TopicFlags};
 
 use crate::build::{BuildMode, build_world_with};
 use crate::record::mcap::McapRecording;
-use crate::run::report::{OutputArgs, report_run};
 use crate::run::exports::RunExports;
+use crate::run::report::{OutputArgs, report_run};
 use crate::run::{RunOptions, RunOutput, run_built};
 use bevy_ecs::prelude::*;
 use feed::FedRobot;

@@ -5,8 +5,8 @@
 use super::ReplayArgs;
 use super::source::{RobotFeed, TimeBase, TopicFlags, first_stamp, robot_feed};
 use crate::batch::sets::{Source, plan_sets};
-use crate::record::topics::RunInfo;
 use crate::record::mcap::McapRecording;
+use crate::record::topics::RunInfo;
 use crate::scenario::scenario_path;
 use crate::scenario::{Scenario, assets_dir};
 use anyhow::{anyhow, bail};

@@ -3,12 +3,12 @@
 //! and the true pose. Our own files carry exact times ([`crate::record::mcap::time_on_grid`]
 //! with the periods of `run.json`); a foreign file's header stamps count from its first stamp.
 
-use crate::record::topics::RunInfo;
-use crate::record::topics::{ACKERMANN_JOINTS, DIFF_DRIVE_JOINTS, ticks_of_angle};
 use crate::record::mcap::messages::{
     Header, JointState, LaserScan as ScanMsg, Odometry, Pose, PoseStamped,
 };
 use crate::record::mcap::{McapRecording, RosMessage, time_on_grid};
+use crate::record::topics::RunInfo;
+use crate::record::topics::{ACKERMANN_JOINTS, DIFF_DRIVE_JOINTS, ticks_of_angle};
 use crate::scenario::RobotConfig;
 use anyhow::{anyhow, bail};
 use systems::body::Kinematics;

@@ -61,7 +61,6 @@ pub struct RunOutput {
     pub interrupted: bool,
 }
 
-
 /// Runs a scenario to its end.
 pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<RunOutput> {
     run(scenario, opts, None, &RunExports::default())
@@ -281,4 +280,3 @@ fn truth_poses(w: &mut World) -> Vec<Pose2> {
     v.sort_by_key(|(i, _)| *i);
     v.into_iter().map(|(_, p)| p).collect()
 }
-

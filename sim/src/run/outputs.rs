@@ -123,4 +123,3 @@ fn finish_slam(w: &mut World) {
         }
     }
 }
-

@@ -1,11 +1,11 @@
 //! `[[events]]`: timed scenario events (routes, kidnapping, sensor faults, doors), checked
 //! against the robots, doors and map they concern.
 
-use serde::Deserialize;
-use super::error::KeyPath;
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
+use super::error::KeyPath;
 use super::{DoorConfig, Event, EventAction, RobotConfig};
+use serde::Deserialize;
 use systems::core::Pose2;
 use systems::world::OccupancyGrid;
 
@@ -73,156 +73,169 @@ pub(super) fn resolve_events(
     points: &PointList,
 ) -> R<Vec<Event>> {
     let mut events = Vec::new();
-    let Known {
-        robots,
-        doors,
-        grid,
-    } = known;
     for (i, e) in files.iter().enumerate() {
         let p = path.index(i);
         let at = c.range(&p.key("at"), e.at, Some(0.0), Some(duration), false)?;
-        if e.kind == EventType::Door {
-            if e.robot.is_some() {
-                return c.err(
-                    &p.key("robot"),
-                    "a door event concerns no robot: remove `robot`",
-                );
-            }
-            for (key, present) in [
-                ("points", e.points.is_some()),
-                ("loop", e.looping.is_some()),
-                ("pose", e.pose.is_some()),
-                ("sensor", e.sensor.is_some()),
-                ("active", e.active.is_some()),
-            ] {
-                if present {
-                    return c.err(
-                        &p.key(key),
-                        format!("`{key}` does not apply to a `door` event"),
-                    );
-                }
-            }
-            let Some(door) = &e.door else {
-                return c.err(
-                    &p,
-                    "a door event needs `door` (a door of the map's places file)",
-                );
-            };
-            let Some(index) = doors.iter().position(|d| &d.name == door) else {
-                let known: Vec<&str> = doors.iter().map(|d| d.name.as_str()).collect();
-                return c.err(
-                    &p.key("door"),
-                    if known.is_empty() {
-                        format!("unknown door `{door}` (the map's places file defines no doors)")
-                    } else {
-                        format!("unknown door `{door}`; known doors: {}", known.join(", "))
-                    },
-                );
-            };
-            let Some(open) = e.open else {
-                return c.err(&p, "a door event needs `open` (true or false)");
-            };
-            events.push(Event {
-                at,
-                robot: None,
-                action: EventAction::Door { index, open },
-            });
-            continue;
-        }
-        if e.door.is_some() || e.open.is_some() {
-            let key = if e.door.is_some() { "door" } else { "open" };
-            return c.err(
-                &p.key(key),
-                format!("`{key}` applies to `door` events only"),
-            );
-        }
-        let Some(robot_name) = &e.robot else {
-            return c.err(&p, "missing key `robot` (the robot the event concerns)");
+        let (robot, action) = if e.kind == EventType::Door {
+            (None, resolve_door_event(c, &p, e, known.doors)?)
+        } else {
+            let action = resolve_robot_event(c, &p, e, &known, point, inside, points)?;
+            (e.robot.clone(), action)
         };
-        let Some(robot) = robots.iter().find(|r| &r.name == robot_name) else {
-            return c.err(&p.key("robot"), format!("no robot named `{robot_name}`"));
-        };
-        let only = |key: &str, present: bool, kind: &str| -> R<()> {
-            if present {
-                return c.err(
-                    &p.key(key),
-                    format!("`{key}` does not apply to a `{kind}` event"),
-                );
-            }
-            Ok(())
-        };
-        let action = match e.kind {
-            EventType::Door => continue, // resolved above
-            EventType::Waypoints => {
-                if robot.navigation.is_some() {
-                    return c.err(
-                        &p.key("robot"),
-                        format!(
-                            "robot `{}` is driven by its tasks; a route event cannot apply",
-                            robot.name
-                        ),
-                    );
-                }
-                only("pose", e.pose.is_some(), "waypoints")?;
-                only("sensor", e.sensor.is_some(), "waypoints")?;
-                only("active", e.active.is_some(), "waypoints")?;
-                EventAction::Waypoints {
-                    points: points(&p, &e.points)?,
-                    looping: e.looping.unwrap_or(false),
-                }
-            }
-            EventType::Teleport => {
-                only("points", e.points.is_some(), "teleport")?;
-                only("loop", e.looping.is_some(), "teleport")?;
-                only("sensor", e.sensor.is_some(), "teleport")?;
-                only("active", e.active.is_some(), "teleport")?;
-                let Some(pose) = &e.pose else {
-                    return c.err(&p, "a teleport event needs `pose` ([x, y, yaw] or a place)");
-                };
-                let pose = point(&p.key("pose"), pose)?;
-                inside(&p.key("pose"), &pose)?;
-                if !grid.disc_is_clear(pose.x, pose.y, robot.footprint.bounding_radius()) {
-                    return c.err(
-                        &p.key("pose"),
-                        "the robot would be placed inside an obstacle",
-                    );
-                }
-                EventAction::Teleport(pose)
-            }
-            EventType::SensorFault => {
-                only("points", e.points.is_some(), "sensor_fault")?;
-                only("loop", e.looping.is_some(), "sensor_fault")?;
-                only("pose", e.pose.is_some(), "sensor_fault")?;
-                let Some(sensor) = e.sensor else {
-                    return c.err(
-                        &p,
-                        "a sensor_fault event needs `sensor` (laser, encoder or sonar)",
-                    );
-                };
-                let has = match sensor {
-                    SensorName::Laser => robot.laser.is_some(),
-                    SensorName::Encoder => robot.encoder.is_some(),
-                    SensorName::Sonar => robot.sonar.is_some(),
-                };
-                if !has {
-                    return c.err(
-                        &p.key("sensor"),
-                        format!("robot `{}` has no {sensor:?} sensor", robot.name).to_lowercase(),
-                    );
-                }
-                EventAction::SensorFault {
-                    sensor,
-                    active: e.active.unwrap_or(true),
-                }
-            }
-        };
-        events.push(Event {
-            at,
-            robot: e.robot.clone(),
-            action,
-        });
+        events.push(Event { at, robot, action });
     }
     // stable: events at the same time fire in file order
     events.sort_by(|a, b| a.at.total_cmp(&b.at));
     Ok(events)
+}
+
+/// A `door` event: the door and whether it opens.
+fn resolve_door_event(
+    c: &Checker,
+    p: &KeyPath,
+    e: &EventFile,
+    doors: &[DoorConfig],
+) -> R<EventAction> {
+    if e.robot.is_some() {
+        return c.err(
+            &p.key("robot"),
+            "a door event concerns no robot: remove `robot`",
+        );
+    }
+    for (key, present) in [
+        ("points", e.points.is_some()),
+        ("loop", e.looping.is_some()),
+        ("pose", e.pose.is_some()),
+        ("sensor", e.sensor.is_some()),
+        ("active", e.active.is_some()),
+    ] {
+        if present {
+            return c.err(
+                &p.key(key),
+                format!("`{key}` does not apply to a `door` event"),
+            );
+        }
+    }
+    let Some(door) = &e.door else {
+        return c.err(
+            p,
+            "a door event needs `door` (a door of the map's places file)",
+        );
+    };
+    let Some(index) = doors.iter().position(|d| &d.name == door) else {
+        let known: Vec<&str> = doors.iter().map(|d| d.name.as_str()).collect();
+        return c.err(
+            &p.key("door"),
+            if known.is_empty() {
+                format!("unknown door `{door}` (the map's places file defines no doors)")
+            } else {
+                format!("unknown door `{door}`; known doors: {}", known.join(", "))
+            },
+        );
+    };
+    let Some(open) = e.open else {
+        return c.err(p, "a door event needs `open` (true or false)");
+    };
+    Ok(EventAction::Door { index, open })
+}
+
+/// An event that concerns a robot: waypoints, teleport or sensor fault.
+fn resolve_robot_event(
+    c: &Checker,
+    p: &KeyPath,
+    e: &EventFile,
+    known: &Known,
+    point: &dyn Fn(&KeyPath, &PointOrPlace) -> R<Pose2>,
+    inside: &dyn Fn(&KeyPath, &Pose2) -> R<()>,
+    points: &PointList,
+) -> R<EventAction> {
+    let Known { robots, grid, .. } = known;
+    if e.door.is_some() || e.open.is_some() {
+        let key = if e.door.is_some() { "door" } else { "open" };
+        return c.err(
+            &p.key(key),
+            format!("`{key}` applies to `door` events only"),
+        );
+    }
+    let Some(robot_name) = &e.robot else {
+        return c.err(p, "missing key `robot` (the robot the event concerns)");
+    };
+    let Some(robot) = robots.iter().find(|r| &r.name == robot_name) else {
+        return c.err(&p.key("robot"), format!("no robot named `{robot_name}`"));
+    };
+    let only = |key: &str, present: bool, kind: &str| -> R<()> {
+        if present {
+            return c.err(
+                &p.key(key),
+                format!("`{key}` does not apply to a `{kind}` event"),
+            );
+        }
+        Ok(())
+    };
+    let action = match e.kind {
+        EventType::Door => return resolve_door_event(c, p, e, known.doors),
+        EventType::Waypoints => {
+            if robot.navigation.is_some() {
+                return c.err(
+                    &p.key("robot"),
+                    format!(
+                        "robot `{}` is driven by its tasks; a route event cannot apply",
+                        robot.name
+                    ),
+                );
+            }
+            only("pose", e.pose.is_some(), "waypoints")?;
+            only("sensor", e.sensor.is_some(), "waypoints")?;
+            only("active", e.active.is_some(), "waypoints")?;
+            EventAction::Waypoints {
+                points: points(p, &e.points)?,
+                looping: e.looping.unwrap_or(false),
+            }
+        }
+        EventType::Teleport => {
+            only("points", e.points.is_some(), "teleport")?;
+            only("loop", e.looping.is_some(), "teleport")?;
+            only("sensor", e.sensor.is_some(), "teleport")?;
+            only("active", e.active.is_some(), "teleport")?;
+            let Some(pose) = &e.pose else {
+                return c.err(p, "a teleport event needs `pose` ([x, y, yaw] or a place)");
+            };
+            let pose = point(&p.key("pose"), pose)?;
+            inside(&p.key("pose"), &pose)?;
+            if !grid.disc_is_clear(pose.x, pose.y, robot.footprint.bounding_radius()) {
+                return c.err(
+                    &p.key("pose"),
+                    "the robot would be placed inside an obstacle",
+                );
+            }
+            EventAction::Teleport(pose)
+        }
+        EventType::SensorFault => {
+            only("points", e.points.is_some(), "sensor_fault")?;
+            only("loop", e.looping.is_some(), "sensor_fault")?;
+            only("pose", e.pose.is_some(), "sensor_fault")?;
+            let Some(sensor) = e.sensor else {
+                return c.err(
+                    &p,
+                    "a sensor_fault event needs `sensor` (laser, encoder or sonar)",
+                );
+            };
+            let has = match sensor {
+                SensorName::Laser => robot.laser.is_some(),
+                SensorName::Encoder => robot.encoder.is_some(),
+                SensorName::Sonar => robot.sonar.is_some(),
+            };
+            if !has {
+                return c.err(
+                    &p.key("sensor"),
+                    format!("robot `{}` has no {sensor:?} sensor", robot.name).to_lowercase(),
+                );
+            }
+            EventAction::SensorFault {
+                sensor,
+                active: e.active.unwrap_or(true),
+            }
+        }
+    };
+    Ok(action)
 }

@@ -3,14 +3,14 @@
 
 use super::check::PointOrPlace;
 use super::events::EventFile;
-use LocalizerFile;
+use super::localizers::LocalizerFile;
 use super::navigation::{NavigationFile, TaskFile};
 use super::outdoor::{RoadsFile, ZoneFile};
 use super::outdoor_robot::{CameraFile, CompassFile, GpsFile, RouteFile};
-use PersonFile;
+use super::people::PersonFile;
 use super::sensors::{EncoderFile, LaserFile};
-use SlamList;
-use SonarFile;
+use super::slam::SlamList;
+use super::sonar::SonarFile;
 use serde::Deserialize;
 
 #[derive(Deserialize, Debug, Default)]
@@ -188,4 +188,3 @@ pub struct SensorsFile {
     pub compass: Option<CompassFile>,
     pub camera: Option<CameraFile>,
 }
-

@@ -2,11 +2,11 @@
 //! task queue. Places in tasks resolve through the map's places file; every value is checked
 //! with the robot and key named in the error.
 
-use serde::Deserialize;
 use super::LocalizerConfig;
-use super::error::KeyPath;
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
+use super::error::KeyPath;
+use serde::Deserialize;
 use systems::body::{Footprint, Kinematics};
 use systems::core::Pose2;
 use systems::navigation::{

@@ -4,8 +4,8 @@
 //! [Park thesis]. Errors name the file, line and key; a road file's own errors keep
 //! their file:line:column.
 
-use super::error::KeyPath;
 use super::check::{Checker, R, check_name};
+use super::error::KeyPath;
 use serde::Deserialize;
 use std::path::Path;
 use std::sync::Arc;

@@ -4,9 +4,9 @@
 //! error, four SRF02 sonars, GPS, compass and camera) and `[robots.route]` (drive to a node of
 //! the road network, localizing on the roads).
 
+use super::check::{Checker, R};
 use super::error::KeyPath;
 use super::outdoor::RoadsConfig;
-use super::check::{Checker, R};
 use serde::Deserialize;
 use systems::body::{Ackermann, Footprint, Kinematics};
 use systems::core::Pose2;
@@ -357,21 +357,15 @@ pub(super) fn resolve_outdoor_sensors(
 ) -> R<(Option<GpsSpec>, Option<CompassSpec>, Option<CameraSpec>)> {
     let has_encoder = t.has_encoder;
     let sp = p.key("sensors");
-    let gps = over_preset(
-        t.gps,
-        preset.map(|pr| pr.gps.clone()),
-        |f, base| resolve_gps(c, &sp.key("gps"), f, base),
-    )?;
-    let compass = over_preset(
-        t.compass,
-        preset.map(|pr| pr.compass.clone()),
-        |f, base| resolve_compass(c, &sp.key("compass"), f, base),
-    )?;
-    let camera = over_preset(
-        t.camera,
-        preset.map(|pr| pr.camera.clone()),
-        |f, base| resolve_camera(c, &sp.key("camera"), f, base),
-    )?;
+    let gps = over_preset(t.gps, preset.map(|pr| pr.gps.clone()), |f, base| {
+        resolve_gps(c, &sp.key("gps"), f, base)
+    })?;
+    let compass = over_preset(t.compass, preset.map(|pr| pr.compass.clone()), |f, base| {
+        resolve_compass(c, &sp.key("compass"), f, base)
+    })?;
+    let camera = over_preset(t.camera, preset.map(|pr| pr.camera.clone()), |f, base| {
+        resolve_camera(c, &sp.key("camera"), f, base)
+    })?;
     if let Some(route) = route {
         let missing: Vec<&str> = [
             ("encoder", !has_encoder),

@@ -1,9 +1,9 @@
 //! The `[[people]]` tables: walking people with a route of points or place names. Every error
 //! names the person and the key.
 
-use super::error::{KeyPath, ScenarioError};
 use super::check::PointOrPlace;
 use super::check::{Checker, R, check_name};
+use super::error::{KeyPath, ScenarioError};
 use serde::Deserialize;
 use systems::body::Person;
 use systems::body::people::{DEFAULT_RADIUS, DEFAULT_SPEED};

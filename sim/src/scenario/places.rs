@@ -2,10 +2,10 @@
 //! (`[places.<name>] pose = [x, y, yaw]`) and doors (`[doors.<name>] from, to, thickness`), with
 //! errors naming the places file and key.
 
-use serde::Deserialize;
 use super::DoorConfig;
-use super::error::{ErrorContext, KeyPath};
 use super::check::{Checker, R};
+use super::error::{ErrorContext, KeyPath};
+use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::core::Pose2;

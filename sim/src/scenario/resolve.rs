@@ -1,19 +1,21 @@
 //! Validation and defaults: turns a [`ScenarioFile`] into a [`Scenario`], reporting the first
 //! problem with the file, line and key.
 
-use super::error::{ErrorContext, KeyPath, ScenarioError};
-use super::check::{Checker, PointOrPlace, R};
+use super::check::{Checker, PointOrPlace, R, check_name};
+use super::error::{ErrorContext, KeyPath};
 use super::file::*;
-use super::outdoor_robot;
-use super::sensors::{resolve_encoder, resolve_laser};
 use super::outdoor::RoadsConfig;
+use super::outdoor_robot;
 use super::outdoor_robot::RouteConfig;
+use super::sensors::{resolve_encoder, resolve_laser};
+use super::sonar::SonarConfig;
 use super::{RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};
 use systems::core::Pose2;
 use systems::navigation::BehaviourKind;
+use systems::sensors::{CameraSpec, CompassSpec, EncoderSpec, GpsSpec, LaserSpec};
 use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
 use systems::world::{Cell, OccupancyGrid, load_map};
 
@@ -54,7 +56,14 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
     let record = resolve_record(&c, &root.key("record"), f.record.as_ref())?;
     let mut robots: Vec<RobotConfig> = Vec::new();
     for (i, r) in f.robots.iter().enumerate() {
-        let robot = resolve_robot(&world, &root.key("robots").index(i), i, r, roads.as_ref(), &robots)?;
+        let robot = resolve_robot(
+            &world,
+            &root.key("robots").index(i),
+            i,
+            r,
+            roads.as_ref(),
+            &robots,
+        )?;
         robots.push(robot);
     }
     let events = super::events::resolve_events(
@@ -299,7 +308,9 @@ impl World<'_> {
                 .err(path, "missing `points` (a list of [x, y] or place names)");
         };
         if pts.is_empty() {
-            return self.c.err(&path.key("points"), "expected at least one point");
+            return self
+                .c
+                .err(&path.key("points"), "expected at least one point");
         }
         let mut out = Vec::new();
         for (i, p) in pts.iter().enumerate() {
@@ -365,49 +376,19 @@ fn resolve_robot(
     let bp = p.key("behaviour");
     let (behaviour, speed, tolerance) =
         resolve_behaviour(w, &bp, r.behaviour.as_ref(), &kinematics)?;
-    let sensors = r.sensors.as_ref();
-    let sp = p.key("sensors");
-    let laser = match sensors.and_then(|s| s.laser.as_ref()) {
-        Some(l) => Some(resolve_laser(c, &sp.key("laser"), l)?),
-        None => None,
-    };
-    let encoder = match sensors.and_then(|s| s.encoder.as_ref()) {
-        Some(e) => Some(resolve_encoder(c, &sp.key("encoder"), e)?),
-        None => preset.as_ref().map(|pr| pr.encoder.clone()),
-    };
-    let default_sonar = super::sonar::SonarFile::default();
-    let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
-        Some(s) => Some(s),
-        None if preset.as_ref().is_some_and(|pr| pr.sonars) => Some(&default_sonar),
-        None => None,
-    };
-    let sonar = match sonar {
-        Some(s) => Some(super::sonar::resolve_sonar(
-            c,
-            &sp.key("sonar"),
-            &r.name,
-            &footprint,
-            s,
-        )?),
-        None => None,
-    };
-    let tables = outdoor_robot::OutdoorTables {
-        gps: sensors.and_then(|s| s.gps.as_ref()),
-        compass: sensors.and_then(|s| s.compass.as_ref()),
-        camera: sensors.and_then(|s| s.camera.as_ref()),
-        has_encoder: encoder.is_some(),
-        driven_otherwise: r.behaviour.is_some() || !r.tasks.is_empty(),
-    };
-    let (gps, compass, camera) =
-        outdoor_robot::resolve_outdoor_sensors(c, p, &tables, preset.as_ref(), route.as_ref())?;
+    let RobotSensors {
+        laser,
+        encoder,
+        sonar,
+        gps,
+        compass,
+        camera,
+    } = resolve_sensors(c, p, r, preset.as_ref(), &footprint, route.as_ref())?;
     let lp = p.key("localization");
-    let mut localizers = super::localizers::resolve_localizers(
-        c,
-        &lp,
-        &r.localization,
-        &start,
-        &|path, v| w.point_inside(path, v),
-    )?;
+    let mut localizers =
+        super::localizers::resolve_localizers(c, &lp, &r.localization, &start, &|path, v| {
+            w.point_inside(path, v)
+        })?;
     let slam = super::slam::resolve_slam(c, &p.key("slam"), r.slam.as_ref(), &start, &localizers)?;
     if !slam.is_empty() && (laser.is_none() || encoder.is_none()) {
         return c.err(
@@ -437,7 +418,10 @@ fn resolve_robot(
         },
         &|path, v| {
             let pose = w.point_inside(path, v)?;
-            if !w.grid.disc_is_clear(pose.x, pose.y, footprint.bounding_radius()) {
+            if !w
+                .grid
+                .disc_is_clear(pose.x, pose.y, footprint.bounding_radius())
+            {
                 return c.err(
                     path,
                     format!(
@@ -491,6 +475,71 @@ fn resolve_robot(
     })
 }
 
+/// A robot's sensors.
+struct RobotSensors {
+    laser: Option<LaserSpec>,
+    encoder: Option<EncoderSpec>,
+    sonar: Option<SonarConfig>,
+    gps: Option<GpsSpec>,
+    compass: Option<CompassSpec>,
+    camera: Option<CameraSpec>,
+}
+
+/// `[robots.sensors]`: each sensor's table over its preset (the robot preset's sensors without
+/// a table).
+fn resolve_sensors(
+    c: &Checker,
+    p: &KeyPath,
+    r: &RobotFile,
+    preset: Option<&outdoor_robot::Preset>,
+    footprint: &Footprint,
+    route: Option<&RouteConfig>,
+) -> R<RobotSensors> {
+    let sensors = r.sensors.as_ref();
+    let sp = p.key("sensors");
+    let laser = match sensors.and_then(|s| s.laser.as_ref()) {
+        Some(l) => Some(resolve_laser(c, &sp.key("laser"), l)?),
+        None => None,
+    };
+    let encoder = match sensors.and_then(|s| s.encoder.as_ref()) {
+        Some(e) => Some(resolve_encoder(c, &sp.key("encoder"), e)?),
+        None => preset.map(|pr| pr.encoder.clone()),
+    };
+    let default_sonar = super::sonar::SonarFile::default();
+    let sonar = match sensors.and_then(|s| s.sonar.as_ref()) {
+        Some(s) => Some(s),
+        None if preset.is_some_and(|pr| pr.sonars) => Some(&default_sonar),
+        None => None,
+    };
+    let sonar = match sonar {
+        Some(s) => Some(super::sonar::resolve_sonar(
+            c,
+            &sp.key("sonar"),
+            &r.name,
+            footprint,
+            s,
+        )?),
+        None => None,
+    };
+    let tables = outdoor_robot::OutdoorTables {
+        gps: sensors.and_then(|s| s.gps.as_ref()),
+        compass: sensors.and_then(|s| s.compass.as_ref()),
+        camera: sensors.and_then(|s| s.camera.as_ref()),
+        has_encoder: encoder.is_some(),
+        driven_otherwise: r.behaviour.is_some() || !r.tasks.is_empty(),
+    };
+    let (gps, compass, camera) =
+        outdoor_robot::resolve_outdoor_sensors(c, p, &tables, preset, route)?;
+    Ok(RobotSensors {
+        laser,
+        encoder,
+        sonar,
+        gps,
+        compass,
+        camera,
+    })
+}
+
 /// A robot's start pose (`start`, or the start of its `route`), clear of obstacles.
 fn resolve_start(
     w: &World,
@@ -517,7 +566,10 @@ fn resolve_start(
         }
     };
     w.inside(&p.key("start"), &start)?;
-    if !w.grid.disc_is_clear(start.x, start.y, footprint.bounding_radius()) {
+    if !w
+        .grid
+        .disc_is_clear(start.x, start.y, footprint.bounding_radius())
+    {
         return c.err(
             &p.key("start"),
             format!(
@@ -557,7 +609,10 @@ fn resolve_behaviour(
     let kind = match b.kind {
         BehaviourType::Idle | BehaviourType::Wander => {
             if b.points.is_some() {
-                return c.err(&bp.key("points"), "only a `waypoints` behaviour takes points");
+                return c.err(
+                    &bp.key("points"),
+                    "only a `waypoints` behaviour takes points",
+                );
             }
             if b.looping.is_some() {
                 return c.err(&bp.key("loop"), "only a `waypoints` behaviour takes `loop`");

@@ -1,9 +1,9 @@
 //! `[robots.sensors.laser]` and `[robots.sensors.encoder]`: presets with overrides, checked,
 //! and the range limits every range sensor shares.
 
-use serde::Deserialize;
-use super::error::KeyPath;
 use super::check::{Checker, R};
+use super::error::KeyPath;
+use serde::Deserialize;
 use systems::core::Pose2;
 use systems::sensors::{EncoderSpec, LaserSpec};
 

@@ -2,9 +2,9 @@
 //! (`[[robots.slam]]`), so several SLAM systems run on identical scans. Each becomes an entry of
 //! the robot's localizers (estimates evaluated and recorded like theirs, under its name).
 
+use super::check::{Checker, R};
 use super::error::KeyPath;
 use super::localizers::{LocalizerConfig, LocalizerKind};
-use super::check::{Checker, R};
 use serde::Deserialize;
 use systems::core::Pose2;
 use systems::mapping::de_map_match::DeMapMatcher;

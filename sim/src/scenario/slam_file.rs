@@ -4,9 +4,9 @@
 //! accepts is accepted here, with the same defaults, checks and error messages (file, line,
 //! key).
 
+use super::check::Checker;
 use super::error::{ErrorContext, KeyPath, ScenarioError};
 use super::localizers::LocalizerConfig;
-use super::check::Checker;
 use super::slam::SlamList;
 use systems::core::Pose2;
 

@@ -5,8 +5,8 @@
 //! (sec. 4.1.2: three in front, straight ahead and 45° to either side, one at the back). Without
 //! either, the robot gets the `hospital` layout. Errors name the robot and the key.
 
-use super::error::KeyPath;
 use super::check::{Checker, R};
+use super::error::KeyPath;
 use serde::Deserialize;
 use systems::body::Footprint;
 use systems::core::Pose2;

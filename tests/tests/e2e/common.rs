@@ -86,8 +86,8 @@ pub fn sim_run(args: &[&str]) -> Result<(), String> {
 
 /// `sim slam ARGS` as the binary runs it, with its report.
 pub fn sim_slam(args: &[&str]) -> Result<sim::log_slam::report::SlamReport, String> {
-    use sim::options::parse_args;
     use sim::log_slam::{SlamArgs, run_slam_command};
+    use sim::options::parse_args;
     let a: SlamArgs = parse_args(args).map_err(|e| e.to_string())?;
     run_slam_command(&a).map_err(|e| format!("{e:#}"))
 }

@@ -10,7 +10,7 @@
 //! says what it stopped at in [`McapRecording::damage`].
 
 use super::cdr;
-use super::recording::{McapRecording, RecordedMessage};
+use super::recording::{Attachment, ChannelInfo, McapRecording, RecordedMessage};
 use super::scan::ReadState;
 use super::schema::RosMessage;
 use super::writer::MESSAGE_ENCODING;

@@ -6,9 +6,9 @@
 //! from the log's first record.
 
 use super::path_trace::PathTrace;
-use super::{close_recording, open_recording};
 use super::slam::{SlamTrack, log_slam_scan, log_slam_state, slam_entity};
 use super::stream::RrdStream;
+use super::{close_recording, open_recording};
 use std::path::Path;
 use systems::core::Pose2;
 use systems::localization::ScanEstimator;

@@ -36,13 +36,13 @@ pub mod rows;
 pub mod slam;
 pub mod stream;
 
-use belief::Cloud;
-use path_trace::PathTrace;
-use stream::RrdStream;
 use crate::scenario::RecordConfig;
+use belief::Cloud;
 use bevy_ecs::prelude::*;
+use path_trace::PathTrace;
 use std::collections::VecDeque;
 use std::path::Path;
+use stream::RrdStream;
 use systems::body::{Footprint, Person, PersonId, PersonIndex, TruePose};
 use systems::core::clock::RateTimer;
 use systems::core::{Pose2, RobotId, RobotIndex, SimClock, wrap_angle};

@@ -17,8 +17,8 @@
 //!
 //! The camera images (`robots/<name>/camera`) come from [`crate::record::frames`].
 
-use super::rows;
 use super::RrdRecorder;
+use super::rows;
 use bevy_ecs::prelude::*;
 use rerun::components::{Position3D, Radius};
 use systems::body::TruePose;

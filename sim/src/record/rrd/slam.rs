@@ -19,8 +19,8 @@
 //! optimization, which doubles the CPU time of a recorded hospital_loop run at the default rate
 //! (lower `slam_rate` for long graph SLAM runs).
 
-use super::{RrdRecorder, grid_map, scan_cloud};
 use super::stream::RrdStream;
+use super::{RrdRecorder, grid_map, scan_cloud};
 use bevy_ecs::prelude::*;
 use systems::core::clock::RateTimer;
 use systems::core::{Pose2, RobotId, RobotIndex, SimClock};

@@ -16,7 +16,7 @@
 //! | `/<r>/compass` | sensor_msgs/Imu | every compass reading: orientation only (REP 145) |
 //! | `/<r>/camera/image_raw` | sensor_msgs/Image | rgb8 frames at the scenario's `record.camera_rate` |
 //! | `/<r>/sonar/<k>` | sensor_msgs/Range | every reading of sonar `k` (mount order) |
-//! | `/tf` | tf2_msgs/TFMessage | every tick: `map` → `<r>/odom` (the best localizer's correction, identity without one) and `<r>/odom` → `<r>/base_link` |
+//! | `/tf` | tf2_msgs/TFMessage | every tick: `map` → `<r>/odom` (the correction of the localizer the robot navigates by, else of its first localizer; identity without one) and `<r>/odom` → `<r>/base_link` |
 //! | `/tf_static` | tf2_msgs/TFMessage | once: `<r>/base_link` → laser, sonar and camera mounts |
 //!
 //! Attachments: `scenario.toml` (the scenario file as loaded) and `run.json` ([`RunInfo`]: the

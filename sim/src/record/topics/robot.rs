@@ -40,7 +40,8 @@ pub(super) struct RobotTopics {
     pub odom_start: Pose2,
     /// The last odometry pose written (stamp, pose).
     pub last_odom: Option<(f64, Pose2)>,
-    /// map → odom from the best localizer's latest estimate, and that estimate's stamp.
+    /// map → odom from the latest estimate of the localizer the robot navigates by (else its
+    /// first), and that estimate's stamp.
     pub correction: Pose2,
     pub correction_stamp: f64,
 }

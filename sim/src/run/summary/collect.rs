@@ -174,4 +174,3 @@ pub(crate) fn event_log(w: &mut World) -> Vec<(f64, String, String)> {
     log.sort_by(|a, b| a.0.total_cmp(&b.0));
     log
 }
-

@@ -4,9 +4,9 @@
 mod fields;
 mod kinds;
 
-use super::error::KeyPath;
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
+use super::error::KeyPath;
 use kinds::*;
 use serde::Deserialize;
 use std::f64::consts::PI;
