@@ -37,7 +37,7 @@ impl Progress {
 
     /// Tick `tick` (from 0) is done.
     pub(super) fn tick(&self, tick: u64, started: Instant) {
-        if tick % self.update_every == 0 || tick + 1 == self.ticks {
+        if tick.is_multiple_of(self.update_every) || tick + 1 == self.ticks {
             let sim_t = (tick + 1) as f64 * self.dt;
             let wall = started.elapsed().as_secs_f64().max(1e-9);
             self.bar.set_position(tick + 1);

@@ -216,7 +216,7 @@ fn resolve_robot_event(
             only("pose", e.pose.is_some(), "sensor_fault")?;
             let Some(sensor) = e.sensor else {
                 return c.err(
-                    &p,
+                    p,
                     "a sensor_fault event needs `sensor` (laser, encoder or sonar)",
                 );
             };
