@@ -15,7 +15,7 @@
 //! summaries) never sees them.
 
 use super::footprint::Footprint;
-use super::physics::TruePose;
+use super::truth::TruePose;
 use crate::core::{Pose2, RobotIndex, SimClock, SimPlugin, SimRng, SimSet};
 use crate::world::{OccupancyGrid, StaticWorld};
 use bevy_ecs::prelude::*;

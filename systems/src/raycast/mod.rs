@@ -23,6 +23,7 @@ mod batch;
 mod batch_avx2;
 mod dda;
 mod fan;
+mod feed;
 mod leap;
 mod overlay;
 mod raymap;
