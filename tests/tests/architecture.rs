@@ -52,7 +52,6 @@ fn systems_has_no_module_cycles() {
 }
 
 #[test]
-#[ignore = "world imports raycast (StaticWorld owns a RayMap): fixed by the next commit"]
 fn systems_layers_point_down() {
     let g = graph(&src("systems").join("lib.rs"));
     let problems = g.layer_violations(SYSTEMS_LEVELS);

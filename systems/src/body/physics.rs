@@ -16,7 +16,8 @@ use super::kinematics::{DriveCommand, DriveState, Kinematics, integrate_arc};
 use super::people::Walker;
 use super::truth::{TruePose, TrueTwist};
 use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
-use crate::world::{StaticWorld, rects::tile_rects};
+use crate::raycast::static_world::{COLLIDER_TILE, StaticWorld};
+use crate::world::rects::tile_rects;
 use bevy_ecs::prelude::*;
 use rapier2d::prelude::*;
 use std::sync::Mutex;
@@ -135,7 +136,7 @@ impl Physics {
             self.world.remove_collider(h);
         }
         let grid = world.grid();
-        for rect in tile_rects(grid, tx, ty, crate::world::COLLIDER_TILE) {
+        for rect in tile_rects(grid, tx, ty, COLLIDER_TILE) {
             let (c, h) = rect.world_box(grid);
             let collider = ColliderBuilder::cuboid(h[0] as Real, h[1] as Real)
                 .translation(Vector::new(c[0] as Real, c[1] as Real))
