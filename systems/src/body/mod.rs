@@ -6,8 +6,10 @@ pub mod footprint;
 pub mod kinematics;
 pub mod people;
 pub mod physics;
+pub mod truth;
 
 pub use footprint::Footprint;
 pub use kinematics::{Ackermann, DiffDrive, DriveCommand, DriveState, Kinematics};
 pub use people::{PeoplePlugin, Person, PersonId, PersonIndex, Walker};
-pub use physics::{Collisions, Physics, PhysicsBody, PhysicsPlugin, TruePose, TrueTwist};
+pub use physics::{Collisions, Physics, PhysicsBody, PhysicsPlugin};
+pub use truth::{TruePose, TrueTwist};

@@ -15,9 +15,10 @@
 //! summaries) never sees them.
 
 use super::footprint::Footprint;
-use super::physics::TruePose;
+use super::truth::TruePose;
 use crate::core::{Pose2, RobotIndex, SimClock, SimPlugin, SimRng, SimSet};
-use crate::world::{OccupancyGrid, StaticWorld};
+use crate::raycast::StaticWorld;
+use crate::world::OccupancyGrid;
 use bevy_ecs::prelude::*;
 use rand::RngExt;
 

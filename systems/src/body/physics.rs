@@ -14,37 +14,13 @@
 use super::footprint::Footprint;
 use super::kinematics::{DriveCommand, DriveState, Kinematics, integrate_arc};
 use super::people::Walker;
+use super::truth::{TruePose, TrueTwist};
 use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
-use crate::world::{StaticWorld, rects::tile_rects};
+use crate::raycast::static_world::{COLLIDER_TILE, StaticWorld};
+use crate::world::rects::tile_rects;
 use bevy_ecs::prelude::*;
 use rapier2d::prelude::*;
 use std::sync::Mutex;
-
-/// Ground-truth pose (never read by estimators, planners or controllers). `prev` is the pose at
-/// the start of the current tick, so sensors firing between ticks can interpolate.
-#[derive(Component, Clone, Copy, Debug, Default)]
-pub struct TruePose {
-    pub pose: Pose2,
-    pub prev: Pose2,
-}
-
-impl TruePose {
-    pub fn at(pose: Pose2) -> Self {
-        TruePose { pose, prev: pose }
-    }
-
-    /// Pose at fraction `f` ∈ [0, 1] of the current tick.
-    pub fn interpolate(&self, f: f64) -> Pose2 {
-        self.prev.lerp(&self.pose, f)
-    }
-}
-
-/// Ground-truth body twist over the last tick (m/s, rad/s).
-#[derive(Component, Clone, Copy, Debug, Default)]
-pub struct TrueTwist {
-    pub v: f64,
-    pub w: f64,
-}
 
 #[derive(Component, Clone, Copy, Debug)]
 pub struct PhysicsBody(pub RigidBodyHandle);
@@ -160,7 +136,7 @@ impl Physics {
             self.world.remove_collider(h);
         }
         let grid = world.grid();
-        for rect in tile_rects(grid, tx, ty, crate::world::COLLIDER_TILE) {
+        for rect in tile_rects(grid, tx, ty, COLLIDER_TILE) {
             let (c, h) = rect.world_box(grid);
             let collider = ColliderBuilder::cuboid(h[0] as Real, h[1] as Real)
                 .translation(Vector::new(c[0] as Real, c[1] as Real))

@@ -5,9 +5,9 @@
 //! own counters (tasks, stops, waits, re-plans, failures) are in
 //! [`NavMetrics`](crate::navigation::NavMetrics).
 
+use super::robot_metrics::RobotMetrics;
 use crate::body::{Collisions, TruePose};
 use crate::core::SimClock;
-use crate::eval::RobotMetrics;
 use crate::navigation::{LegEvent, NavCostmaps, Navigator, Planner, PlannerParams};
 use bevy_ecs::prelude::*;
 

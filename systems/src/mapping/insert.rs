@@ -5,9 +5,23 @@
 //! implements [`CellStore`]: the contiguous grid of [`super::LogOddsMap`] or the copy-on-write
 //! tiles of a particle's map in [`super::rbpf`].
 
-use super::occupancy::{InsertStats, OccupancyParams, log_odds};
+use super::inverse_model::{OccupancyParams, log_odds};
 use crate::core::Pose2;
 use crate::raycast::traverse_segment;
+
+/// What one scan contributed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct InsertStats {
+    /// Beams that ended on an obstacle (inside the grid).
+    pub hits: usize,
+    /// Beams without a return that cleared space.
+    pub clears: usize,
+    /// Readings not used: NaN, −Inf, below `range_min`.
+    pub ignored: usize,
+    /// The cells [c0, c1) × [r0, r1) the scan may have changed (the box of the sensor and the
+    /// beams' ends with a cell of margin, clipped to the grid), for callers that mirror the map.
+    pub window: Option<[usize; 4]>,
+}
 
 /// One usable beam of a scan: unit direction in the map frame, length (m), and whether it ends
 /// on a return (false: a beam without a return, clearing only).

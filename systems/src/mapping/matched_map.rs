@@ -4,7 +4,8 @@
 //! the window a scan touched (Kohlbrecher et al., SSRR 2011, §IV: Hector's map update and match
 //! loop). The scan-to-map SLAM owns one; the graph SLAM one per submap.
 
-use super::occupancy::{LogOddsMap, OccupancyParams, probability};
+use super::inverse_model::{OccupancyParams, probability};
+use super::occupancy::LogOddsMap;
 use crate::core::Pose2;
 use crate::matching::ProbGrid;
 use crate::matching::gauss_newton::{GaussNewtonParams, GnResult, OdometryPrior, match_scan};

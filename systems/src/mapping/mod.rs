@@ -25,6 +25,7 @@ pub mod de_map_match;
 pub mod graph_slam;
 mod grow;
 mod insert;
+pub mod inverse_model;
 pub mod matched_map;
 pub mod occupancy;
 pub mod pose_graph;
@@ -36,7 +37,9 @@ pub mod scan_to_map;
 mod tests;
 
 pub use align::{refine_alignment, start_pose_alignment};
-pub use occupancy::{InsertStats, LogOddsMap, OccupancyParams};
+pub use insert::InsertStats;
+pub use inverse_model::OccupancyParams;
+pub use occupancy::LogOddsMap;
 pub use quality::{MapQuality, map_quality, quality_with_start_pose};
 
 pub use graph_slam::{GraphSlam, GraphSlamConfig};

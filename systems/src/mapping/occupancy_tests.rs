@@ -1,4 +1,5 @@
 use super::*;
+use crate::mapping::inverse_model::log_odds;
 use crate::raycast::RayMap;
 use crate::world::Cell;
 use crate::world::map_file::{load_map, save_map};

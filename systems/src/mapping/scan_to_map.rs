@@ -10,8 +10,8 @@
 //! sliding. The map frame is the world frame: the SLAM starts at the robot's known start pose.
 
 use super::de_map_match::{DeMapMatcher, match_de};
+use super::inverse_model::OccupancyParams;
 use super::matched_map::{MatchedMap, base_points};
-use super::occupancy::OccupancyParams;
 use crate::core::{Pose2, SimRng, wrap_angle};
 use crate::localization::{PoseEstimate, ScanEstimator};
 use crate::matching::ProbGrid;

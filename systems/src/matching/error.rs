@@ -1,6 +1,6 @@
 //! Errors of the scan matcher: every bad configuration or input is reported, never a panic.
 
-use super::de::Strategy;
+use super::de::strategy::Strategy;
 
 /// What is wrong with a matching request.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

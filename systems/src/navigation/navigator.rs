@@ -22,8 +22,6 @@
 mod blocking;
 mod clearance;
 
-use blocking::{CLEAR_TIME, Resumed};
-
 use super::astar::{PlanError, Planner, PlannerParams};
 use super::avoid::SectorRanges;
 use super::costmap::Costmap;
@@ -135,6 +133,18 @@ pub struct Navigator {
     /// Since when the robot has been held by an obstacle on its way aside.
     held_since: Option<f64>,
 }
+
+/// A stop the robot went on from: when it began, where, and when the robot went on.
+#[derive(Clone, Copy, Debug)]
+struct Resumed {
+    since: f64,
+    at: [f64; 2],
+    time: f64,
+}
+
+/// The way must look clear this long (s) before a stopped robot goes on: one clear reading of a
+/// noisy sensor is not enough.
+const CLEAR_TIME: f64 = 0.5;
 
 /// A plan around an obstacle longer than this many times the rest of the current path (plus
 /// [`DETOUR_SLACK`] m) is refused up to [`MAX_DETOUR_REFUSALS`] times in a row, one `wait_time`

@@ -5,7 +5,7 @@
 //! per run, so a whole rebuild is cheaper to get right than a windowed one.
 
 use super::costmap::{Costmap, CostmapParams};
-use crate::world::StaticWorld;
+use crate::raycast::StaticWorld;
 use bevy_ecs::prelude::*;
 
 #[derive(Resource, Clone, Debug)]

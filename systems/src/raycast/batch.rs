@@ -11,44 +11,13 @@
 //! This is what a particle filter needs (every particle's beams at once: the `calc_range_many`
 //! of range_libc, Walsh & Karaman 2018) and what scans fall back to when the sweep does not apply.
 
+use super::feed::Feed;
 use super::leap::{Bounds, Lane};
 use super::raymap::RayMap;
 
 /// Rays in flight in the scalar kernel. Eight is enough to hide an L2/L3 load behind the other
 /// lanes' arithmetic.
 const LANES: usize = 8;
-
-/// The rays of a stream in order, placed where they enter the grid; rays with nothing to walk
-/// (starting outside the grid and missing it, or undefined) are answered on the way.
-pub(super) struct Feed<'a, F> {
-    ray: F,
-    n: usize,
-    next: usize,
-    b: &'a Bounds,
-    origin: [f32; 2],
-    max_range: f32,
-}
-
-impl<F: Fn(usize) -> ([f32; 2], f32, f32)> Feed<'_, F> {
-    /// The next ray to walk, its `id` set to its index, or None when the stream is done.
-    #[inline]
-    pub fn next(&mut self, out: &mut [f32]) -> Option<Lane> {
-        while self.next < self.n {
-            let i = self.next;
-            self.next += 1;
-            let (p, dx, dy) = (self.ray)(i);
-            let (gx, gy) = (p[0] - self.origin[0], p[1] - self.origin[1]);
-            match Lane::start(gx, gy, dx, dy, self.b, self.max_range) {
-                Ok(mut l) => {
-                    l.id = i;
-                    return Some(l);
-                }
-                Err(answer) => out[i] = answer,
-            }
-        }
-        None
-    }
-}
 
 impl RayMap {
     /// Casts rays `(origin, angle)` into `out` (same length): `out[i]` is what
@@ -76,14 +45,7 @@ impl RayMap {
         out: &mut [f32],
     ) {
         let b = Bounds::new(self.width(), self.height(), self.resolution());
-        let feed = Feed {
-            ray,
-            n,
-            next: 0,
-            b: &b,
-            origin: self.origin(),
-            max_range,
-        };
+        let feed = Feed::new(ray, n, &b, self.origin(), max_range);
         #[cfg(target_arch = "x86_64")]
         if self.stream_avx2() {
             // SAFETY: AVX2 was detected; the padded field fits `i32` indices (`stream_avx2`)

@@ -17,7 +17,7 @@
 //! Only built for x86-64; `batch` detects AVX2 at run time and needs the distance field padded
 //! by three bytes (a 4-byte gather at its last cell) and indexable by `i32`.
 
-use super::batch::Feed;
+use super::feed::Feed;
 use super::leap::{Bounds, Lane};
 use std::arch::x86_64::*;
 

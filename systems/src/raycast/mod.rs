@@ -14,6 +14,10 @@
 //!   faces locally.
 //! - [`overlay_circles`], [`overlay_segments`]: moving obstacles (other robots) drawn into an
 //!   already-cast scan, touching only the beams inside each obstacle's angular interval.
+//! - [`StaticWorld`]: the static world resource, an occupancy grid with its ray map and the
+//!   collider tiles physics rebuilds, kept in step by every edit; [`Doors`] edit it at run time.
+//!   They live here, not in `world`, because they own a [`RayMap`] and `world` is below
+//!   `raycast`.
 //!
 //! Conventions: f32 metres and radians; row 0 is the bottom row; outside the grid is free; a ray
 //! starting in an occupied cell returns 0; no hit within `max_range` returns `f32::INFINITY`.
@@ -22,15 +26,20 @@ mod batch;
 #[cfg(target_arch = "x86_64")]
 mod batch_avx2;
 mod dda;
+pub mod doors;
 mod fan;
+mod feed;
 mod leap;
 mod overlay;
 mod raymap;
+pub mod static_world;
 pub mod sweep;
 
 pub use dda::{cast_dda, traverse_segment};
+pub use doors::{Door, Doors};
 pub use overlay::{overlay_circles, overlay_segments};
 pub use raymap::RayMap;
+pub use static_world::{COLLIDER_TILE, StaticWorld};
 
 #[cfg(test)]
 mod tests;

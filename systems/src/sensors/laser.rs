@@ -11,8 +11,8 @@ use crate::core::clock::RateTimer;
 use crate::core::normal::fill_standard_normal;
 use crate::core::spatial_order::SpatialOrder;
 use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimRng};
+use crate::raycast::StaticWorld;
 use crate::raycast::{overlay_circles, overlay_segments};
-use crate::world::StaticWorld;
 use bevy_ecs::prelude::*;
 use rand::RngExt;
 

@@ -234,8 +234,9 @@ pub fn update_robot_outlines(
 mod tests {
     use super::*;
     use crate::core::{KernelPool, Pose2, SimClock, stream_rng};
+    use crate::raycast::StaticWorld;
     use crate::sensors::laser::{Laser, LaserScans, LaserSpec, LaserTruth, sample_lasers};
-    use crate::world::{Cell, OccupancyGrid, StaticWorld};
+    use crate::world::{Cell, OccupancyGrid};
 
     /// A noiseless laser on robot 0 looking along +x at a person standing 3 m ahead (centre),
     /// radius 0.25: the middle beam measures 2.75 m; a second robot behind the person is hidden.

@@ -12,8 +12,7 @@
 //! again, for [`ROUNDS`] rounds of halving jitter, the last on the filter's own likelihood
 //! field. The [`KEEP`] survivors are the proposal; the filter's weighting decides between them.
 
-use super::LaserModelParams;
-use super::sensor_model::{likelihood_table, weigh_likelihood_field};
+use super::sensor_model::{LaserModelParams, likelihood_table, weigh_likelihood_field};
 use crate::core::{SimRng, wrap_angle};
 use crate::localization::map::LocalizationMap;
 use rand::RngExt;

@@ -10,7 +10,8 @@
 //! rebuild after each of them.
 
 use crate::core::{Pose2, wrap_angle};
-use crate::mapping::occupancy::{LogOddsMap, OccupancyParams};
+use crate::mapping::inverse_model::OccupancyParams;
+use crate::mapping::occupancy::LogOddsMap;
 use crate::matching::ProbGrid;
 use crate::sensors::LaserScan;
 use std::sync::Mutex;

@@ -10,8 +10,8 @@
 //! G = global(anchor) ⊕ local(anchor)⁻¹, mapping its local coordinates into the global frame.
 
 use crate::core::Pose2;
+use crate::mapping::inverse_model::OccupancyParams;
 use crate::mapping::matched_map::MatchedMap;
-use crate::mapping::occupancy::OccupancyParams;
 use crate::matching::{PrecomputedGrids, ProbGrid, likelihood_grid};
 use crate::sensors::LaserScan;
 use crate::world::Cell;

@@ -1,6 +1,6 @@
 use super::submap::Submaps;
 use crate::core::Pose2;
-use crate::mapping::occupancy::OccupancyParams;
+use crate::mapping::inverse_model::OccupancyParams;
 use crate::sensors::LaserScan;
 
 fn ring_scan() -> LaserScan {

@@ -30,8 +30,8 @@ mod tests;
 pub mod tile_map;
 
 use super::insert::{Beam, LogOddsModel};
+use super::inverse_model::{OccupancyParams, log_odds};
 use super::matched_map::base_points;
-use super::occupancy::{OccupancyParams, log_odds};
 use crate::core::moments::weighted_scatter;
 use crate::core::{Pose2, SimRng, wrap_angle};
 use crate::localization::mcl::resample::low_variance_indices;

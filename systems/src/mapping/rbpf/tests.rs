@@ -43,7 +43,7 @@ fn tile_map_holds_the_same_cells_as_the_contiguous_map() {
             let (gc, gr) = g.cell_of(x, y).expect("the tile map covers the flat map");
             assert_eq!(g.get(gc, gr), f.get(c, r), "cell at ({x}, {y})");
             let l = tiles.get(tiles.cell(x, y));
-            assert_eq!(super::super::occupancy::probability(l), f.get(c, r));
+            assert_eq!(super::super::inverse_model::probability(l), f.get(c, r));
             compared += 1;
             occupied += (f.get(c, r) > 0.5) as usize;
         }

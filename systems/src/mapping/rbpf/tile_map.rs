@@ -10,9 +10,9 @@
 //! [i·res, (i+1)·res) × [j·res, (j+1)·res)); the table grows by whole tiles to hold each scan.
 
 use super::super::insert::{
-    CellStore, GridFrame, LogOddsModel, apply_beams, beam_box, prepare_beams,
+    CellStore, GridFrame, InsertStats, LogOddsModel, apply_beams, beam_box, prepare_beams,
 };
-use super::super::occupancy::{InsertStats, OccupancyParams, probability};
+use super::super::inverse_model::{OccupancyParams, probability};
 use crate::core::Pose2;
 use crate::matching::ProbGrid;
 use crate::sensors::LaserScan;

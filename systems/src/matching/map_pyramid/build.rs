@@ -1,7 +1,7 @@
 //! Building the pyramid's levels: corner samples for surfaces on faces, the 2 × 2 combine and the
 //! max-preserving smoothing, each over a window so edits stay local.
 
-use super::{Combine, PyramidLevel, PyramidOptions, Window};
+use super::level::{Combine, PyramidLevel, PyramidOptions, Window};
 use crate::matching::ProbGrid;
 
 /// Corner (i, j) (the lower-left corner of cell (i, j)) gets max P · (1 − min P) over the cells

@@ -6,17 +6,6 @@ use super::{ControlContext, Navigator, Phase, PlanRequest};
 use crate::core::Pose2;
 use crate::navigation::fleet::{Fleet, FleetActivity, comes_through, gives_way, yield_spot};
 
-/// A stop the robot went on from: when it began, where, and when the robot went on.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Resumed {
-    pub(super) since: f64,
-    pub(super) at: [f64; 2],
-    pub(super) time: f64,
-}
-
-/// The way must look clear this long (s) before a stopped robot goes on: one clear reading of a
-/// noisy sensor is not enough.
-pub(super) const CLEAR_TIME: f64 = 0.5;
 /// Stopping again within this time (s) and distance (m) of going on continues the same stop
 /// (same start of waiting, not counted again).
 const SAME_STOP_TIME: f64 = 3.0;

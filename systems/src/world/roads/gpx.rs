@@ -2,7 +2,9 @@
 //! road; the track's `<name>` names it and its `<type>` gives the surface. The thesis reduced
 //! the OpenStreetMap export of its park to such tracks ([Park thesis §5.1]).
 
-use super::{RawRoads, Road, RoadError, RoadOptions, Source, Surface, default_width};
+use super::graph::Road;
+use super::raw::{RawRoads, RoadError, RoadOptions, Source, default_width};
+use super::surface::Surface;
 
 pub(super) fn read(src: &Source, options: &RoadOptions) -> Result<RawRoads, RoadError> {
     let root = src.doc.root_element();

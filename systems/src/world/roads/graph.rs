@@ -5,8 +5,8 @@
 //! edges widened to their road's width are the road surface the camera sees and off-road
 //! detection tests against.
 
-use super::Surface;
 use super::geo::{LocalProjection, azimuth_of};
+use super::surface::Surface;
 
 /// Index of a node in [`RoadGraph::nodes`].
 pub type NodeId = usize;

@@ -2,7 +2,9 @@
 //! `<node id lat lon>` and `<way id>` with `<nd ref>` and `<tag k v>` children. Roads are the
 //! ways with a `highway` tag (see the module docs of [`super`] for what is skipped).
 
-use super::{RawRoads, Road, RoadError, RoadOptions, Source, Surface, default_width, parse_width};
+use super::graph::Road;
+use super::raw::{RawRoads, RoadError, RoadOptions, Source, default_width, parse_width};
+use super::surface::Surface;
 
 /// Highway values that are not drivable roads (yet or any more).
 const NOT_ROADS: &[&str] = &[

@@ -17,7 +17,8 @@
 //! 3–8 px and the verge is three cells. The price is memory: one byte per cell, about 35 MB
 //! for the 324 × 274 m park grid (the graph's bounds plus a 15 m margin).
 
-use super::{RoadGraph, Surface};
+use super::graph::RoadGraph;
+use super::surface::Surface;
 
 /// Class of the ground off the roads.
 pub const GRASS: u8 = 0;

@@ -1,3 +1,4 @@
+use super::raw::parse_width;
 use super::*;
 use std::path::PathBuf;
 

@@ -18,7 +18,7 @@
 #[cfg(target_arch = "x86_64")]
 mod avx2;
 
-use super::GroundRays;
+use super::pinhole::GroundRays;
 use super::shade::{self, Rgb};
 use crate::core::Pose2;
 use crate::world::roads::surface_raster::{CLASSES, GRASS, SurfaceRaster};

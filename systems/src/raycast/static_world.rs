@@ -2,8 +2,8 @@
 //! ray-casting map; the physics collider tiles, rebuilt by the physics bridge from the dirty list).
 //! Every edit goes through [`StaticWorld::set_cells`] so all views stay consistent.
 
-use super::grid::{Cell, OccupancyGrid};
-use crate::raycast::RayMap;
+use super::raymap::RayMap;
+use crate::world::grid::{Cell, OccupancyGrid};
 use bevy_ecs::prelude::Resource;
 
 /// Side of a physics collider tile, in cells (64 cells = 3.2 m at 5 cm).

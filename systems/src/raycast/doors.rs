@@ -3,9 +3,9 @@
 //! ray map, the physics colliders of the touched tiles and everything derived from the world's
 //! version (the navigation costmaps) follow; opening restores exactly the cells it took.
 
-use super::grid::Cell;
-use super::shapes::Shape;
 use super::static_world::StaticWorld;
+use crate::world::grid::Cell;
+use crate::world::shapes::Shape;
 use bevy_ecs::prelude::Resource;
 
 #[derive(Clone, Debug, PartialEq)]
