@@ -63,7 +63,6 @@ fn systems_layers_point_down() {
 }
 
 #[test]
-#[ignore = "sim restructure in progress"]
 fn sim_has_no_module_cycles() {
     for root in ["lib.rs", "main.rs"] {
         let g = graph(&src("sim").join(root));

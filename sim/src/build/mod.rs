@@ -28,7 +28,7 @@ use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
     SonarTruth, Sonars,
 };
-use systems::world::{Door, Doors, StaticWorld};
+use systems::raycast::{Door, Doors, StaticWorld};
 
 /// A world ready to step.
 pub struct SimWorld {

@@ -10,7 +10,7 @@ use systems::core::SimClock;
 use systems::localization::LocalizationMap;
 use systems::navigation::Behaviour;
 use systems::sensors::{Encoder, Laser, Sonars};
-use systems::world::{Doors, StaticWorld};
+use systems::raycast::{Doors, StaticWorld};
 
 #[derive(Resource)]
 pub struct EventQueue {

@@ -163,7 +163,7 @@ fn run_world(
     capture: Option<&ScanCapture>,
     exports: &RunExports,
 ) -> anyhow::Result<RunOutput> {
-    outputs::install(&mut sim, scenario, opts, exports)?;
+    outputs::install(&mut sim, scenario, opts.rrd.as_deref(), exports)?;
     let mut capturer = capture.map(Capturer::new);
     let stepped = step_to_end(&mut sim, scenario, opts, capturer.as_mut());
     let frame_error = outputs::finish_estimators_and_frames(&mut sim.world);

@@ -11,10 +11,10 @@ use crate::record::rrd::outdoor::{OutdoorRecording, record_outdoor};
 use crate::record::rrd::slam::{SlamRecording, record_slam, record_slam_final};
 use crate::record::topics::{McapExport, record_mcap};
 use crate::record::{RrdRecorder, record_navigation, record_rrd};
-use crate::run::RunOptions;
 use crate::run::exports::{Exported, RunExports};
 use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
+use std::path::Path;
 use systems::core::{SimClock, SimSet};
 use systems::localization::{Filter, Localizers};
 use systems::sensors::Camera;
@@ -23,10 +23,10 @@ use systems::sensors::Camera;
 pub(crate) fn install(
     sim: &mut SimWorld,
     scenario: &Scenario,
-    opts: &RunOptions,
+    rrd: Option<&Path>,
     exports: &RunExports,
 ) -> anyhow::Result<()> {
-    if let Some(path) = &opts.rrd {
+    if let Some(path) = rrd {
         let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
         sim.world.insert_resource(rec);
         sim.world.insert_resource(SlamRecording::new(
@@ -44,7 +44,7 @@ pub(crate) fn install(
         );
     }
     exports.install(sim, scenario)?;
-    install_frames(sim, scenario, opts, exports)
+    install_frames(sim, scenario, rrd.is_some(), exports)
 }
 
 /// Renders whole camera frames for the recordings on a worker thread when a recording is
@@ -52,12 +52,12 @@ pub(crate) fn install(
 fn install_frames(
     sim: &mut SimWorld,
     scenario: &Scenario,
-    opts: &RunOptions,
+    rrd: bool,
     exports: &RunExports,
 ) -> anyhow::Result<()> {
     let outputs = FrameOutputs {
         raw: exports.mcap.is_some(),
-        jpeg: opts.rrd.is_some(),
+        jpeg: rrd,
     };
     let cameras = sim.world.query::<&Camera>().iter(&sim.world).count();
     if cameras == 0 || !(outputs.raw || outputs.jpeg) {

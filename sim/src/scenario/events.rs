@@ -4,7 +4,7 @@
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
 use super::error::KeyPath;
-use super::{DoorConfig, Event, EventAction, RobotConfig};
+use super::model::{DoorConfig, Event, EventAction, RobotConfig, SensorName};
 use serde::Deserialize;
 use systems::core::Pose2;
 use systems::world::OccupancyGrid;
@@ -17,14 +17,6 @@ pub enum EventType {
     Teleport,
     SensorFault,
     Door,
-}
-
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
-#[serde(rename_all = "snake_case")]
-pub enum SensorName {
-    Laser,
-    Encoder,
-    Sonar,
 }
 
 #[derive(Deserialize, Debug)]

@@ -2,7 +2,7 @@
 //! task queue. Places in tasks resolve through the map's places file; every value is checked
 //! with the robot and key named in the error.
 
-use super::LocalizerConfig;
+use super::localizers::LocalizerConfig;
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
 use super::error::KeyPath;

@@ -2,7 +2,7 @@
 //! (`[places.<name>] pose = [x, y, yaw]`) and doors (`[doors.<name>] from, to, thickness`), with
 //! errors naming the places file and key.
 
-use super::DoorConfig;
+use super::model::DoorConfig;
 use super::check::{Checker, R};
 use super::error::{ErrorContext, KeyPath};
 use serde::Deserialize;

@@ -9,7 +9,7 @@ use super::outdoor_robot;
 use super::outdoor_robot::RouteConfig;
 use super::sensors::{resolve_encoder, resolve_laser};
 use super::sonar::SonarConfig;
-use super::{RecordConfig, RobotConfig, Scenario};
+use super::model::{RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};

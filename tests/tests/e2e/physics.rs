@@ -145,7 +145,8 @@ fn no_tunnelling_through_a_thin_wall_at_top_speed() {
 
 #[test]
 fn a_door_edit_changes_physics_and_lasers() {
-    use systems::world::{Cell, StaticWorld};
+    use systems::raycast::StaticWorld;
+    use systems::world::Cell;
     // a wall across the room at x = 5 with a 1.2 m door gap around y = 5
     let text = format!(
         "{}\n[[robots]]\nname = \"r\"\nstart = [2.0, 5.0, 0.0]\nbehaviour = {{ type = \"waypoints\", points = [[8.0, 5.0]], speed = 1.0 }}\n[robots.sensors.encoder]\n[robots.sensors.laser]\nnoise_std = 0.0\nmin_range = 0.05\n",

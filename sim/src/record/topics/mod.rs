@@ -37,6 +37,7 @@ mod robot;
 
 pub use convert::{ACKERMANN_JOINTS, DIFF_DRIVE_JOINTS, ticks_of_angle};
 pub use record::record_mcap;
+pub use robot::TopicInfo;
 
 use crate::record::mcap::messages::{TFMessage, TransformStamped};
 use crate::record::mcap::{Channel, McapRecorder, McapStats, ROS2_PROFILE};
@@ -45,17 +46,6 @@ use bevy_ecs::prelude::*;
 use robot::RobotTopics;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-
-/// A topic as `run.json` lists it.
-#[derive(Serialize, Deserialize, Clone, Debug)]
-pub struct TopicInfo {
-    pub topic: String,
-    #[serde(rename = "type")]
-    pub r#type: String,
-    pub robot: String,
-    /// The period of the stamps' time grid (s): stamps are `k · period_s`.
-    pub period_s: f64,
-}
 
 /// The `run.json` attachment.
 #[derive(Serialize, Deserialize, Clone, Debug)]

@@ -1,7 +1,7 @@
 //! One robot's topics: which it gets (one per sensor it carries), their channels, frames and
 //! periods, its static transforms, and what the recorder remembers between ticks.
 
-use super::TopicInfo;
+use serde::{Deserialize, Serialize};
 use super::convert::transform;
 use crate::record::mcap::messages::*;
 use crate::record::mcap::{Channel, McapRecorder, RosMessage};
@@ -9,6 +9,17 @@ use bevy_ecs::prelude::*;
 use systems::core::{Pose2, RobotId, RobotIndex};
 use systems::localization::{OdometryModel, WheelOdometry};
 use systems::sensors::{Camera, Compass, Encoder, Gps, Laser, Sonars};
+
+/// A topic as `run.json` lists it.
+#[derive(Serialize, Deserialize, Clone, Debug)]
+pub struct TopicInfo {
+    pub topic: String,
+    #[serde(rename = "type")]
+    pub r#type: String,
+    pub robot: String,
+    /// The period of the stamps' time grid (s): stamps are `k · period_s`.
+    pub period_s: f64,
+}
 
 /// A sonar ring's constant message fields.
 pub(super) struct SonarTopics {

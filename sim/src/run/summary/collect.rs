@@ -2,7 +2,7 @@
 //! the truth, and the event log.
 
 use super::{NavigationFailure, NavigationSummary, RobotSummary};
-use crate::run::RobotLocalization;
+use crate::formats::tum::RobotLocalization;
 use bevy_ecs::prelude::*;
 use systems::body::TruePose;
 use systems::core::{RobotId, RobotIndex};

@@ -308,3 +308,62 @@ pub(super) fn resolve_de_odometry(
         start,
     })
 }
+
+/// Validates one robot's list. `pose` resolves coordinates or place names; `start` is the
+/// robot's start pose.
+pub(in crate::scenario) fn resolve_localizers(
+    c: &Checker,
+    p: &KeyPath,
+    list: &[LocalizerFile],
+    start: &Pose2,
+    pose: &dyn Fn(&KeyPath, &PointOrPlace) -> R<Pose2>,
+) -> R<Vec<LocalizerConfig>> {
+    let mut out: Vec<LocalizerConfig> = Vec::new();
+    for (i, l) in list.iter().enumerate() {
+        let lp = p.index(i);
+        let name = match &l.name {
+            Some(n) => {
+                if !crate::scenario::check::check_name(n) {
+                    return c.err(
+                        &lp.key("name"),
+                        format!("expected letters, digits, `_` or `-`, got `{n}`"),
+                    );
+                }
+                n.clone()
+            }
+            None => l.kind.name().to_string(),
+        };
+        if let Some(key) = l.given().into_iter().find(|k| !l.kind.keys().contains(k)) {
+            return c.err(
+                &lp.key(key),
+                format!(
+                    "`{key}` does not apply to a `{}` localizer (its keys: {})",
+                    l.kind.name(),
+                    l.kind.keys().join(", ")
+                ),
+            );
+        }
+        if out.iter().any(|o| o.name == name) {
+            let key = if l.name.is_some() { "name" } else { "type" };
+            return c.err(
+                &lp.key(key),
+                format!("two localizers named `{name}` on one robot: give each a `name`"),
+            );
+        }
+        let kind = match l.kind {
+            LocalizerType::Mcl => LocalizerKind::Mcl(resolve_mcl(c, &lp, l, start, pose)?),
+            LocalizerType::MarkovGrid => {
+                LocalizerKind::MarkovGrid(resolve_markov_grid(c, &lp, l, start, pose)?)
+            }
+            LocalizerType::DeFilter => {
+                LocalizerKind::DeFilter(resolve_de_filter(c, &lp, l, start, pose)?)
+            }
+            LocalizerType::DeMc => LocalizerKind::DeMc(resolve_de_mc(c, &lp, l, start, pose)?),
+            LocalizerType::DeOdometry => {
+                LocalizerKind::DeOdometry(resolve_de_odometry(c, &lp, l, start, pose)?)
+            }
+        };
+        out.push(LocalizerConfig { name, kind });
+    }
+    Ok(out)
+}

@@ -1,7 +1,7 @@
-//! The writer thread of [`super::McapRecorder`]: takes the batches in order and writes them
+//! The writer thread of the MCAP recorder: takes the batches in order and writes them
 //! through the `mcap` crate's writer (lz4 chunks, checksums, file writes), then the summary.
 
-use super::{Batch, MESSAGE_ENCODING, McapStats, Op, Output};
+use super::ops::{Batch, DEFAULT_FLUSH_PERIOD_NS, MESSAGE_ENCODING, McapStats, Op, Output};
 use crate::record::mcap::schema::SCHEMA_ENCODING;
 use anyhow::anyhow;
 use std::collections::{BTreeMap, HashMap};
@@ -27,7 +27,7 @@ impl FileWriter {
             path,
             writer,
             sequences: HashMap::new(),
-            flush_period_ns: Some(super::DEFAULT_FLUSH_PERIOD_NS),
+            flush_period_ns: Some(DEFAULT_FLUSH_PERIOD_NS),
             last_flush_ns: None,
             latest_ns: 0,
         }

@@ -30,15 +30,15 @@ use std::sync::{Mutex, mpsc};
 use std::thread::JoinHandle;
 
 mod file;
+mod ops;
 
 use file::FileWriter;
+use ops::{Batch, Op, Reply};
+pub(crate) use ops::Output;
+pub use ops::{DEFAULT_FLUSH_PERIOD_NS, MESSAGE_ENCODING, McapStats};
 
 /// The MCAP profile of ROS 2 recordings.
 pub const ROS2_PROFILE: &str = "ros2";
-/// The message encoding of the `ros2` profile.
-pub const MESSAGE_ENCODING: &str = "cdr";
-/// Default automatic flush period (ns of log time).
-pub const DEFAULT_FLUSH_PERIOD_NS: u64 = 10_000_000_000;
 /// A batch goes to the writer thread when its payloads reach this size (bytes) ...
 const BATCH_BYTES: usize = 256 * 1024;
 /// ... or it holds this many operations.
@@ -46,9 +46,6 @@ const BATCH_OPS: usize = 2048;
 /// Batches waiting for the writer thread at most (the caller waits when there are more).
 pub const QUEUED_BATCHES: usize = 8;
 
-/// Where an MCAP file goes: a file, or a test's stand-in.
-pub(crate) trait Output: std::io::Write + std::io::Seek + Send {}
-impl<T: std::io::Write + std::io::Seek + Send> Output for T {}
 
 /// A registered topic whose messages are of type `T`.
 pub struct Channel<T> {
@@ -70,14 +67,6 @@ impl<T> Channel<T> {
     }
 }
 
-/// What [`McapRecorder::finish`] wrote.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct McapStats {
-    pub messages: u64,
-    pub channels: usize,
-    pub chunks: usize,
-    pub attachments: usize,
-}
 
 /// An MCAP file being written. See the module doc.
 pub struct McapRecorder {
@@ -96,62 +85,7 @@ pub struct McapRecorder {
     worker: Option<JoinHandle<anyhow::Result<McapStats>>>,
 }
 
-/// Operations for the writer thread, in order; message payloads lie in [`Batch::data`].
-#[derive(Default)]
-struct Batch {
-    ops: Vec<Op>,
-    data: Vec<u8>,
-}
 
-type Reply<T> = mpsc::Sender<anyhow::Result<T>>;
-
-enum Op {
-    /// A message whose payload ends at `end` in the batch's data (and starts where the
-    /// previous message's ended, or at 0).
-    Message {
-        channel: u16,
-        log_time: u64,
-        end: usize,
-    },
-    /// A message the writer thread encodes ([`McapRecorder::write_owned`]).
-    Owned {
-        channel: u16,
-        log_time: u64,
-        msg: Box<dyn Encode>,
-    },
-    Schema {
-        id: u16,
-        name: &'static str,
-        definition: &'static str,
-    },
-    Channel {
-        id: u16,
-        schema: u16,
-        topic: String,
-    },
-    Attach {
-        name: String,
-        media_type: String,
-        data: Vec<u8>,
-    },
-    FlushPeriod(Option<u64>),
-    Flush(Reply<()>),
-    /// Stop as a dying process would: no summary, buffered bytes lost (tests).
-    #[cfg_attr(not(test), allow(dead_code))]
-    Abandon,
-}
-
-/// A message to encode later, on the writer thread.
-trait Encode: Send + Sync {
-    /// Its CDR payload, into `out` (cleared first).
-    fn encode_into(&self, out: &mut Vec<u8>);
-}
-
-impl<T: RosMessage + Send + Sync> Encode for T {
-    fn encode_into(&self, out: &mut Vec<u8>) {
-        cdr::encode_into(out, self);
-    }
-}
 
 impl McapRecorder {
     /// Creates (truncates) `path` and writes the MCAP header with `profile` (use

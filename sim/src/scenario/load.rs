@@ -1,0 +1,95 @@
+//! Finding and loading scenario files: a path or the name of a bundled scenario.
+
+use super::error::ScenarioError;
+use super::model::Scenario;
+use std::path::{Path, PathBuf};
+
+/// Loads and validates a scenario file.
+pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
+    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        file: path.display().to_string(),
+        line: None,
+        column: None,
+        key: None,
+        message: format!("cannot read: {e}"),
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scenario");
+    parse_scenario(&text, &path.display().to_string(), &base, stem)
+}
+
+/// Parses and validates scenario text; relative paths resolve against `base_dir`.
+pub fn parse_scenario(
+    text: &str,
+    file_label: &str,
+    base_dir: &Path,
+    default_name: &str,
+) -> Result<Scenario, ScenarioError> {
+    super::resolve::resolve(text, file_label, base_dir, default_name)
+}
+
+/// The folder of the bundled assets: `$SIM_ASSETS` or the repository's `assets/`
+/// ([`systems::core::source`]).
+pub fn assets_dir() -> PathBuf {
+    match std::env::var_os("SIM_ASSETS") {
+        Some(p) => PathBuf::from(p),
+        None => systems::core::source::source_path("assets"),
+    }
+}
+
+/// Bundled scenarios: (name, path), sorted; an error naming the folder when it cannot be read
+/// (a `sim` binary run away from its repository, without `SIM_ASSETS`).
+pub fn bundled_scenarios() -> anyhow::Result<Vec<(String, PathBuf)>> {
+    let dir = assets_dir().join("scenarios");
+    let entries = std::fs::read_dir(&dir).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot read the bundled scenarios ({e}); set SIM_ASSETS to the repository's \
+             assets folder",
+            dir.display()
+        )
+    })?;
+    let mut out: Vec<(String, PathBuf)> = entries
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .filter_map(|p| Some((p.file_stem()?.to_str()?.to_string(), p.clone())))
+        .collect();
+    out.sort();
+    Ok(out)
+}
+
+/// The scenario `sim run` uses without an argument.
+pub const DEFAULT_SCENARIO: &str = "hospital_patrol";
+
+/// Resolves a scenario argument: a path, or the name of a bundled scenario; otherwise an error
+/// that lists the bundled ones.
+pub fn find_scenario(arg: &str) -> anyhow::Result<PathBuf> {
+    let p = PathBuf::from(arg);
+    if p.exists() {
+        return Ok(p);
+    }
+    let all = bundled_scenarios()
+        .map_err(|e| anyhow::anyhow!("{arg}: no such file, and no bundled scenarios: {e}"))?;
+    if let Some((_, p)) = all.iter().find(|(name, _)| name == arg) {
+        return Ok(p.clone());
+    }
+    let names: Vec<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
+    anyhow::bail!(
+        "{arg}: no such file and no bundled scenario of that name (bundled: {})",
+        names.join(", ")
+    )
+}
+
+/// A scenario file or the name of a bundled scenario (default: hospital_patrol).
+pub fn scenario_arg(arg: Option<&str>) -> anyhow::Result<Scenario> {
+    Ok(load_scenario(&scenario_path(arg)?)?)
+}
+
+/// The file of a scenario argument: a path, or the name of a bundled scenario (default:
+/// hospital_patrol).
+pub fn scenario_path(arg: Option<&str>) -> anyhow::Result<PathBuf> {
+    find_scenario(arg.unwrap_or(DEFAULT_SCENARIO))
+}
