@@ -4,7 +4,8 @@
 # The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
 # the Python SDK's RrdReader), Foxglove's Python MCAP readers (mcap, mcap-ros2-support) and evo
 # (evo_ape, evo_rpe); this script installs them from PyPI into virtual environments once (under
-# $SIM_CACHE, default ~/.cache/sim) and points the tests at them.
+# $SIM_CACHE, default ~/.cache/sim) and points the tests at them, requiring them
+# (SIM_REQUIRE_TOOLS=1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -36,5 +37,8 @@ assert v('evo') == '1.38.1'" 2>/dev/null; then
     "$evo_venv/bin/pip" install --quiet --disable-pip-version-check "evo==1.38.1"
 fi
 export SIM_EVO_VENV="$evo_venv"
+# Without their tools, plain `cargo test` skips the checks that need them; here every one runs,
+# and a tool missing from its venv fails its tests.
+export SIM_REQUIRE_TOOLS=1
 
 cargo test --release --workspace

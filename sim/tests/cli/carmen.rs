@@ -1,7 +1,7 @@
 //! `sim slam --carmen`, `sim run --carmen-out` and `--save-map` through the binary: exit codes,
-//! messages, printed counts and default file names.
+//! messages, printed counts and default file names, and I/O errors that say what failed once.
 
-use super::{ROOM, expect_failure, run_ok};
+use crate::common::{ROOM, expect_failure, run_ok, sim};
 
 fn fixture(name: &str) -> String {
     systems::core::source::source_path("tests/fixtures/carmen")
@@ -152,4 +152,37 @@ fn slam_rates_must_not_be_negative() {
             "`record.slam_rate`: expected a number of at least 0",
         ],
     );
+}
+
+#[test]
+fn carmen_io_errors_say_read_or_write_and_give_the_cause_once() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    std::fs::write(dir.path().join("afile"), "").unwrap();
+    let err = |args: &[&str], cause: &str| {
+        let out = sim(args, dir.path());
+        assert!(!out.status.success(), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(err.matches(cause).count(), 1, "{err}");
+        err
+    };
+    let e = err(
+        &[
+            "run",
+            "tiny.toml",
+            "--no-rrd",
+            "--quiet",
+            "--duration",
+            "0.1",
+            "--carmen-out",
+            "afile/c",
+        ],
+        "Not a directory",
+    );
+    assert!(e.contains("afile/c: cannot write"), "{e}");
+    let e = err(
+        &["slam", "--carmen", "nosuch", "--no-rrd", "--quiet"],
+        "No such file",
+    );
+    assert!(e.contains("nosuch: cannot read"), "{e}");
 }

@@ -7,6 +7,7 @@ use sim::record::mcap::messages::LaserScan;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use systems::core::test_tools::{TestTool, test_tool};
 
 /// Starts `sim run maze_run` for a long time (it runs at some 200× real time; the heavy
 /// hospital_patrol would make the time reached depend on the machine's load), signals it once
@@ -73,15 +74,15 @@ fn check_interrupted(signal: &str) {
         stderr.contains(&format!("interrupted at t = {sim_time:.2} s")),
         "{stderr}"
     );
-    // Foxglove's reader opens it too (summary section and all) when the test tools are there
-    if let Some(venv) = std::env::var_os("SIM_RERUN_VENV") {
+    // Foxglove's reader opens it too (summary section and all)
+    if let Some(venv) = test_tool(TestTool::McapReaders) {
         let script = "import sys\nfrom mcap.reader import make_reader\n\
                       r = make_reader(open(sys.argv[1], 'rb'))\n\
                       s = r.get_summary()\n\
                       n = sum(1 for _ in r.iter_messages())\n\
                       assert s is not None and s.statistics.message_count == n, n\n\
                       print(n)\n";
-        let out = Command::new(Path::new(&venv).join("bin/python"))
+        let out = Command::new(venv.join("bin/python"))
             .args(["-c", script])
             .arg(&path)
             .output()

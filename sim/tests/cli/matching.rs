@@ -1,10 +1,9 @@
 //! `sim scans` and `sim match` as a user runs them: the scans CSV of a short bundled scenario
 //! parses, a known pair is recovered (within 0.1 m and 2° of the true transform), `--json` has
 //! the documented fields, and every bad input the commands check ends with a clear message and a
-//! non-zero exit code (one test per case).
+//! non-zero exit code (one test per case); absurd sizes are refused before the file is read.
 
-use crate::run_ok;
-use crate::sim as sim_command;
+use crate::common::{self, run_ok, sim as sim_command};
 use sim::formats::scans::{SCANS_HEADER, ScanRecord, read_scans};
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -467,5 +466,75 @@ fn scans_unwritable_output() {
         ],
         dir.path(),
         &["no/such/dir/x.csv", "cannot create the scans file"],
+    );
+}
+
+// ---- sim match: sizes beyond the limits, refused before the file is read (some by the
+// argument parser, with its exit code 2) ----
+
+/// `sim match` on a file that is never read: the options are checked first.
+fn match_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "match",
+        "never-read.csv",
+        "--reference",
+        "0",
+        "--current",
+        "1",
+    ];
+    args.extend(extra);
+    args
+}
+
+#[test]
+fn match_refuses_a_population_or_generations_beyond_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    for pop in ["100001", "4294967296"] {
+        common::expect_failure(
+            &match_args(&["--fitness", "euclidean", "--pop", pop]),
+            dir.path(),
+            &["--pop", pop, "100000"],
+        );
+    }
+    for gens in ["1000001", "4294967296"] {
+        common::expect_failure(
+            &match_args(&["--fitness", "euclidean", "--gens", gens]),
+            dir.path(),
+            &["--gens", gens, "1000000"],
+        );
+    }
+}
+
+#[test]
+fn match_refuses_a_window_beyond_100_m() {
+    let dir = tempfile::tempdir().unwrap();
+    for max_xy in ["100.5", "1e4", "1e5", "1e9", "inf"] {
+        common::expect_failure(
+            &match_args(&["--max-xy", max_xy]),
+            dir.path(),
+            &["--max-xy: expected a positive distance", "at most 100"],
+        );
+    }
+}
+
+#[test]
+fn match_refuses_a_mutation_constant_above_2() {
+    let dir = tempfile::tempdir().unwrap();
+    for f in ["2.5", "1e12", "inf"] {
+        common::expect_failure(
+            &match_args(&["--fitness", "correlation", "-F", f]),
+            dir.path(),
+            &["-F:", "F must be in (0, 2]"],
+        );
+    }
+}
+
+#[test]
+fn match_refuses_a_time_limit_too_long_for_a_duration() {
+    let dir = tempfile::tempdir().unwrap();
+    common::expect_failure(
+        &match_args(&["--fitness", "correlation", "--time", "1e300"]),
+        dir.path(),
+        &["--time: 1e300 seconds is too long"],
     );
 }

@@ -1,6 +1,6 @@
 //! `sim replay` exit codes and messages for files it cannot use.
 
-use super::{expect_failure, run_ok};
+use crate::common::{expect_failure, run_ok};
 
 #[test]
 fn corrupt_truncated_and_foreign_files_are_clear_errors() {

@@ -13,6 +13,7 @@ pub mod rng;
 pub mod schedule;
 pub mod source;
 pub mod spatial_order;
+pub mod test_tools;
 
 pub use clock::SimClock;
 pub use ids::{RobotId, RobotIndex};

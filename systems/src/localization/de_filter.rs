@@ -227,3 +227,34 @@ fn discard(pop: &mut Population, c: &DeFilterConfig) {
         costs: order.iter().map(|&i| pop.costs[i]).collect(),
     };
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+    use crate::localization::test_drive::{convergence, corridor_errors, de_motion, hospital};
+
+    /// On the hospital map, from global initialisation the filter converges on the corridor
+    /// drive and then tracks.
+    #[test]
+    fn de_filter_converges_from_global_initialisation() {
+        let map = hospital();
+        let mut f = DeFilter::new(
+            DeFilterConfig {
+                motion: de_motion(),
+                ..DeFilterConfig::default()
+            },
+            &map,
+            stream_rng(4, "test", "de"),
+        );
+        let errors = corridor_errors(|beams, odom| {
+            f.update(&map, beams, odom).then(|| f.estimate().unwrap())
+        });
+        let (since, tracked, n) = convergence(&errors);
+        let since = since.unwrap_or_else(|| panic!("never converged in {n} updates"));
+        assert!(since < 40 && tracked > 0.9, "{since} {tracked}");
+        let t = &f.tracker;
+        assert!(t.converged && t.population.len() == f.config.min_population);
+        assert!(t.evaluations < 2_000_000, "{}", t.evaluations);
+    }
+}

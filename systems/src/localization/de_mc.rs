@@ -168,3 +168,31 @@ fn iterate(t: &mut DeTracker, c: &DeMcConfig, map: &LocalizationMap, beams: &Bea
     }
     accepted
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+    use crate::localization::test_drive::{convergence, corridor_errors, de_motion, hospital};
+
+    /// On the hospital map, from global initialisation the chains converge on the corridor
+    /// drive and then track.
+    #[test]
+    fn de_mc_converges_from_global_initialisation() {
+        let map = hospital();
+        let mut f = DeMc::new(
+            DeMcConfig {
+                motion: de_motion(),
+                ..DeMcConfig::default()
+            },
+            &map,
+            stream_rng(4, "test", "demc"),
+        );
+        let errors = corridor_errors(|beams, odom| {
+            f.update(&map, beams, odom).then(|| f.estimate().unwrap())
+        });
+        let (since, tracked, n) = convergence(&errors);
+        let since = since.unwrap_or_else(|| panic!("never converged in {n} updates"));
+        assert!(since < 40 && tracked > 0.9, "{since} {tracked}");
+    }
+}

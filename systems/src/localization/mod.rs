@@ -20,8 +20,6 @@ pub mod road_wiring;
 pub mod scan_estimator;
 
 #[cfg(test)]
-mod de_tests;
-#[cfg(test)]
 pub(crate) mod test_drive;
 
 pub use localizer::{Filter, Localizer, Localizers, StampedEstimate};

@@ -246,7 +246,6 @@ impl LogOddsMap {
 }
 
 #[cfg(test)]
-#[path = "occupancy_tests.rs"]
 mod tests;
 
 /// [`LogOddsMap`]'s cells as a [`CellStore`].

@@ -187,5 +187,4 @@ pub fn road_steering(
 }
 
 #[cfg(test)]
-#[path = "road_follow_tests.rs"]
 mod tests;

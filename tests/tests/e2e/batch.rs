@@ -1,6 +1,6 @@
 //! `sim batch`: per-run files with every metric, the aggregate table, determinism whatever
-//! `--jobs`, a broken parameter set that fails alone, shards that cover the batch, and clear
-//! errors for bad arguments.
+//! `--jobs`, a broken parameter set that fails alone, and shards that cover the batch (its
+//! messages for bad arguments: sim/tests/cli/batch.rs).
 
 use crate::common::*;
 use serde_json::Value;
@@ -11,13 +11,6 @@ use std::path::Path;
 fn batch(args: &[&str]) -> Result<BatchReport, String> {
     let a: BatchArgs = parse_args(args).map_err(|e| e.to_string())?;
     batch_command(&a).map_err(|e| format!("{e:#}"))
-}
-
-fn batch_error(args: &[&str]) -> String {
-    match batch(args) {
-        Ok(r) => panic!("sim batch {args:?} should fail, ran {} runs", r.runs),
-        Err(e) => e,
-    }
 }
 
 fn jsonl(path: &Path) -> Vec<serde_json::Map<String, Value>> {
@@ -251,54 +244,4 @@ fn shards_cover_the_batch_exactly() {
         "{agg}"
     );
     assert!(agg.contains("\n1,1,3,0,sim_time_s,3,1,0,1,1\n"), "{agg}");
-    let e = merge(&[&s0, &s0]).unwrap_err();
-    assert!(e.contains("job 0 is in both"), "{e}");
-}
-
-#[test]
-fn bad_arguments_give_clear_errors() {
-    let e = batch_error(&["maze_run", "--seeds", "5..2"]);
-    assert!(e.contains("--seeds 5..2: the range is empty"), "{e}");
-    let e = batch_error(&["maze_run", "--seeds", "0-3"]);
-    assert!(e.contains("--seeds 0-3: expected a range A..B"), "{e}");
-    let e = batch_error(&["maze_run", "--seeds", "0..2", "--set", "duration"]);
-    assert!(e.contains("--set duration: expected KEY=VALUE"), "{e}");
-    let e = batch_error(&[
-        "maze_run",
-        "--seeds",
-        "0..2",
-        "--set",
-        "robots.0.sensors.laser.rte=5",
-    ]);
-    assert!(e.starts_with("--set robots.0.sensors.laser.rte=5: "), "{e}");
-    assert!(
-        e.contains("`robots[0].sensors.laser.rte`: unknown field `rte`"),
-        "{e}"
-    );
-    let e = batch_error(&["maze_run", "--seeds", "0..2", "--set", "duration=abc"]);
-    assert!(e.starts_with("--set duration=abc: "), "{e}");
-    assert!(e.contains("maze_run.toml:9"), "{e}");
-    let e = batch_error(&[
-        "maze_run",
-        "--seeds",
-        "0..2",
-        "--set",
-        "robots[name=r9].speed=1",
-    ]);
-    assert!(
-        e.contains("`robots` has no item with name = r9 (its items' name: scout)"),
-        "{e}"
-    );
-    let e = batch_error(&["maze_run", "--seeds", "0..2", "--shard", "2/2"]);
-    assert!(e.contains("--shard 2/2: K must be below N"), "{e}");
-    let e = batch_error(&["maze_run", "--seeds", "0..2", "--duration", "-1"]);
-    assert!(
-        e.contains("--duration: expected a positive number of seconds, got -1"),
-        "{e}"
-    );
-    let e = batch_error(&["no_such_scenario", "--seeds", "0..2"]);
-    assert!(
-        e.contains("no_such_scenario: no such file and no bundled scenario"),
-        "{e}"
-    );
 }

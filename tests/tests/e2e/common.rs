@@ -1,6 +1,7 @@
 use sim::build::{SimWorld, build_world};
 use sim::scenario::{Scenario, assets_dir, parse_scenario};
 use std::path::{Path, PathBuf};
+pub use systems::core::test_tools::{TestTool, test_tool};
 
 /// Parses a scenario given as TOML text (relative paths against the assets folder).
 pub fn scenario(text: &str) -> Scenario {
@@ -38,28 +39,6 @@ pub fn bundled(name: &str) -> PathBuf {
     assets_dir().join("scenarios").join(format!("{name}.toml"))
 }
 
-/// The Rerun 0.36.3 tools: `$SIM_RERUN_VENV` (set by tests/run.sh).
-pub fn rerun_venv() -> PathBuf {
-    match std::env::var_os("SIM_RERUN_VENV") {
-        Some(v) => PathBuf::from(v),
-        None => panic!(
-            "SIM_RERUN_VENV is not set: run the tests with tests/run.sh, which installs \
-             rerun-sdk 0.36.3 in a virtual environment"
-        ),
-    }
-}
-
-/// evo 1.38.1 (`evo_ape`, `evo_rpe`): `$SIM_EVO_VENV` (set by tests/run.sh).
-pub fn evo_venv() -> PathBuf {
-    match std::env::var_os("SIM_EVO_VENV") {
-        Some(v) => PathBuf::from(v),
-        None => panic!(
-            "SIM_EVO_VENV is not set: run the tests with tests/run.sh, which installs evo \
-             1.38.1 in a virtual environment"
-        ),
-    }
-}
-
 pub fn repo_file(rel: &str) -> PathBuf {
     systems::core::source::source_root().join("tests").join(rel)
 }
@@ -93,11 +72,17 @@ pub fn sim_slam(args: &[&str]) -> Result<sim::log_slam::report::SlamReport, Stri
 }
 
 /// Checks an .rrd with the Rerun 0.36.3 tools: `rerun rrd verify`, then the SDK's reader
-/// through check_rrd.py, whose JSON (entity paths, timelines, scalar statistics) it returns.
-pub fn check_rrd(path: &Path) -> serde_json::Value {
+/// through check_rrd.py, whose JSON (entity paths, timelines, scalar statistics) it returns;
+/// `None` when the tools are missing (see [`test_tool`]: the test skips its check).
+#[track_caller]
+pub fn check_rrd(path: &Path) -> Option<serde_json::Value> {
+    test_tool(TestTool::Rerun).map(|rerun| check_rrd_with(&rerun, path))
+}
+
+/// [`check_rrd`] with the Rerun tools of the virtual environment `rerun`.
+pub fn check_rrd_with(rerun: &Path, path: &Path) -> serde_json::Value {
     use std::process::Command;
-    let venv = rerun_venv();
-    let verify = Command::new(venv.join("bin/rerun"))
+    let verify = Command::new(rerun.join("bin/rerun"))
         .args(["rrd", "verify"])
         .arg(path)
         .output()
@@ -108,7 +93,7 @@ pub fn check_rrd(path: &Path) -> serde_json::Value {
         String::from_utf8_lossy(&verify.stdout),
         String::from_utf8_lossy(&verify.stderr)
     );
-    let out = Command::new(venv.join("bin/python"))
+    let out = Command::new(rerun.join("bin/python"))
         .arg(repo_file("check_rrd.py"))
         .arg(path)
         .output()

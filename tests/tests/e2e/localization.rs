@@ -353,6 +353,9 @@ fn grid_and_de_localizer_errors_name_the_key() {
 /// `sim run --trajectories` and agrees with the summary's ATE and RPE to 1e-6 m (and rad).
 #[test]
 fn evo_agrees_with_our_ate_and_rpe() {
+    let Some(evo) = test_tool(TestTool::Evo) else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let mut sc = load_scenario(&bundled("hospital_patrol")).unwrap();
     sc.duration = 15.0;
@@ -366,7 +369,7 @@ fn evo_agrees_with_our_ate_and_rpe() {
     sim::formats::tum::write_trajectories(&traj, &out.localization).unwrap();
     let summary = dir.path().join("summary.json");
     std::fs::write(&summary, serde_json::to_string(&out.summary).unwrap()).unwrap();
-    let res = std::process::Command::new(evo_venv().join("bin/python"))
+    let res = std::process::Command::new(evo.join("bin/python"))
         .arg(repo_file("check_evo.py"))
         .args([&traj, &summary])
         .output()

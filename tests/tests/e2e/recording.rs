@@ -9,6 +9,9 @@ use std::process::Command;
 
 #[test]
 fn rrd_opens_in_rerun_and_has_the_entity_paths() {
+    let Some(rerun) = test_tool(TestTool::Rerun) else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("patrol.rrd");
     let mut s = load_scenario(&bundled("hospital_patrol")).unwrap();
@@ -23,8 +26,8 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
         },
     )
     .unwrap();
-    let v = check_rrd(&path);
-    let stats = Command::new(rerun_venv().join("bin/rerun"))
+    let v = check_rrd_with(&rerun, &path);
+    let stats = Command::new(rerun.join("bin/rerun"))
         .args(["rrd", "stats"])
         .arg(&path)
         .output()

@@ -56,6 +56,9 @@ fn a_sonar_fault_stops_new_readings() {
 
 #[test]
 fn recording_has_the_sonar_entity() {
+    let Some(rerun) = test_tool(TestTool::Rerun) else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sonar.rrd");
     run_scenario(
@@ -68,7 +71,7 @@ fn recording_has_the_sonar_entity() {
         },
     )
     .unwrap();
-    let paths = entity_paths(&check_rrd(&path));
+    let paths = entity_paths(&check_rrd_with(&rerun, &path));
     assert!(paths.iter().any(|p| p == "/robots/a/sonar"), "{paths:?}");
     assert!(!paths.iter().any(|p| p == "/robots/b/sonar"), "{paths:?}");
 }

@@ -4,7 +4,6 @@
 
 use super::messages::*;
 use super::{McapRecorder, McapRecording, ROS2_PROFILE};
-use std::path::PathBuf;
 
 pub const SEC: u64 = 1_000_000_000;
 pub const SCENARIO: &str = "[world]\nmap = \"maps/office.yaml\"\n";
@@ -200,18 +199,19 @@ pub fn write_all_types(rec: &mut McapRecorder, seconds: u64) -> Vec<(&'static st
 
 /// Foxglove's Python readers (mcap 1.6.0, mcap-ros2-support 0.6.0, installed by tests/run.sh in
 /// `$SIM_RERUN_VENV`) decode every message of a file with every message type, with the counts
-/// and field values we wrote: `tests/check_mcap.py` on the sample of [`write_sample`].
+/// and field values we wrote: `tests/check_mcap.py` on the sample of [`write_sample`]. Skipped
+/// without the readers, unless `SIM_REQUIRE_TOOLS=1` ([`systems::core::test_tools`]).
 #[test]
 fn python_ros2_readers_decode_every_message() {
-    let venv = std::env::var_os("SIM_RERUN_VENV").expect(
-        "SIM_RERUN_VENV is not set: run the tests with tests/run.sh, which installs the Python \
-         MCAP readers",
-    );
+    use systems::core::test_tools::{TestTool, test_tool};
+    let Some(venv) = test_tool(TestTool::McapReaders) else {
+        return;
+    };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("sample.mcap");
     write_sample(&path);
     let script = systems::core::source::source_path("tests/check_mcap.py");
-    let out = std::process::Command::new(PathBuf::from(venv).join("bin/python"))
+    let out = std::process::Command::new(venv.join("bin/python"))
         .arg(script)
         .arg(&path)
         .arg(path.with_extension("counts.json"))

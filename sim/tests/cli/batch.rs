@@ -1,9 +1,10 @@
-//! `sim batch`, `sim batch-merge` and `sim bench batch` with bad input: absurd `--jobs` and
-//! batches too large to plan are refused before anything is allocated or spawned, empty sweep
-//! values name their key, and batch-merge refuses to overwrite a shard, to mix shards of
-//! different batches and to merge a batch with shards missing.
+//! `sim batch`, `sim batch-merge` and `sim bench batch` with bad input: bad seeds, `--set`
+//! keys, shards and durations are clear errors naming the option, absurd `--jobs` and batches
+//! too large to plan are refused before anything is allocated or spawned, empty sweep values
+//! name their key, and batch-merge refuses to overwrite a shard, to take one twice, to mix
+//! shards of different batches and to merge a batch with shards missing.
 
-use crate::{ROOM, expect_failure, run_ok, sim};
+use crate::common::{ROOM, expect_failure, run_ok, sim};
 use std::path::Path;
 
 /// A folder with `tiny.toml` (the 2 s room of the CLI tests) and `other.toml` (the same room
@@ -179,6 +180,12 @@ fn merge_refuses_to_overwrite_a_shard() {
     );
     let after = std::fs::read_to_string(dir.path().join("s0/runs.jsonl")).unwrap();
     assert_eq!(before, after);
+    // a shard given twice
+    expect_failure(
+        &["batch-merge", "m", "s0", "s0"],
+        dir.path(),
+        &["job 0 is in both"],
+    );
     // the shards merge into another folder, which is then a whole batch of its own
     run_ok(&["batch-merge", "m", "s0", "s1", "--quiet"], dir.path());
     let rows = std::fs::read_to_string(dir.path().join("m/runs.jsonl")).unwrap();
@@ -231,4 +238,69 @@ fn merge_refuses_missing_shards() {
         &["batch.json: cannot read"],
     );
     assert!(!dir.path().join("m").exists());
+}
+
+/// `sim batch ARGS` fails without a panic; the message after `error: `.
+fn batch_error(args: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let all: Vec<&str> = ["batch"].iter().chain(args).copied().collect();
+    let out = sim(&all, dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success(),
+        "sim batch {args:?} should fail: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    match err.split_once("error: ") {
+        Some((_, e)) => e.to_string(),
+        None => panic!("no error in: {err}"),
+    }
+}
+
+#[test]
+fn bad_arguments_give_clear_errors() {
+    let e = batch_error(&["maze_run", "--seeds", "5..2"]);
+    assert!(e.contains("--seeds 5..2: the range is empty"), "{e}");
+    let e = batch_error(&["maze_run", "--seeds", "0-3"]);
+    assert!(e.contains("--seeds 0-3: expected a range A..B"), "{e}");
+    let e = batch_error(&["maze_run", "--seeds", "0..2", "--set", "duration"]);
+    assert!(e.contains("--set duration: expected KEY=VALUE"), "{e}");
+    let e = batch_error(&[
+        "maze_run",
+        "--seeds",
+        "0..2",
+        "--set",
+        "robots.0.sensors.laser.rte=5",
+    ]);
+    assert!(e.starts_with("--set robots.0.sensors.laser.rte=5: "), "{e}");
+    assert!(
+        e.contains("`robots[0].sensors.laser.rte`: unknown field `rte`"),
+        "{e}"
+    );
+    let e = batch_error(&["maze_run", "--seeds", "0..2", "--set", "duration=abc"]);
+    assert!(e.starts_with("--set duration=abc: "), "{e}");
+    assert!(e.contains("maze_run.toml:9"), "{e}");
+    let e = batch_error(&[
+        "maze_run",
+        "--seeds",
+        "0..2",
+        "--set",
+        "robots[name=r9].speed=1",
+    ]);
+    assert!(
+        e.contains("`robots` has no item with name = r9 (its items' name: scout)"),
+        "{e}"
+    );
+    let e = batch_error(&["maze_run", "--seeds", "0..2", "--shard", "2/2"]);
+    assert!(e.contains("--shard 2/2: K must be below N"), "{e}");
+    let e = batch_error(&["maze_run", "--seeds", "0..2", "--duration", "-1"]);
+    assert!(
+        e.contains("--duration: expected a positive number of seconds, got -1"),
+        "{e}"
+    );
+    let e = batch_error(&["no_such_scenario", "--seeds", "0..2"]);
+    assert!(
+        e.contains("no_such_scenario: no such file and no bundled scenario"),
+        "{e}"
+    );
 }

@@ -1,0 +1,194 @@
+//! `sim run` and `sim scenarios`: the default file names, the summary JSON and the table, bad
+//! input and a missing assets folder, and output into a closed pipe.
+
+use crate::common::{ROOM, expect_failure, sim, sim_env};
+use std::process::Command;
+
+#[test]
+fn run_writes_default_rrd_and_summary_json() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let out = sim(
+        &[
+            "run",
+            "tiny.toml",
+            "--seed",
+            "5",
+            "--summary",
+            "s.json",
+            "--quiet",
+        ],
+        dir.path(),
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        dir.path().join("tiny-seed5.rrd").exists(),
+        "default .rrd name"
+    );
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    assert_eq!(s["scenario"], "tiny");
+    assert_eq!(s["seed"], 5);
+    assert!((s["sim_time_s"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+    for key in ["wall_time_s", "real_time_factor"] {
+        assert!(s[key].as_f64().unwrap() > 0.0, "{key}");
+    }
+    let r = &s["robots"][0];
+    assert_eq!(r["name"], "r1");
+    for key in ["distance_m", "collisions", "odometry_drift_m"] {
+        assert!(r[key].is_number(), "{key} in {r}");
+    }
+    assert!(r["distance_m"].as_f64().unwrap() > 0.3);
+}
+
+#[test]
+fn no_rrd_writes_nothing_and_prints_the_table() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let out = sim(
+        &["run", "tiny.toml", "--no-rrd", "--duration", "0.5"],
+        dir.path(),
+    );
+    assert!(out.status.success());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("r1") && stdout.contains("odom drift"),
+        "{stdout}"
+    );
+    let rrds = std::fs::read_dir(dir.path())
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "rrd")
+        })
+        .count();
+    assert_eq!(rrds, 0);
+}
+
+#[test]
+fn without_the_assets_folder_bundled_names_fail_and_say_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no_assets");
+    let run = |args: &[&str]| sim_env(args, dir.path(), &[("SIM_ASSETS", &missing)]);
+    for args in [&["run", "hospital_patrol"][..], &["scenarios"][..]] {
+        let out = run(args);
+        assert!(!out.status.success(), "{args:?} should fail");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        for f in [
+            "no_assets",
+            "cannot read the bundled scenarios",
+            "SIM_ASSETS",
+        ] {
+            assert!(err.contains(f), "{args:?}: expected `{f}` in: {err}");
+        }
+    }
+    // a scenario file needs no bundled folder
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let out = run(&[
+        "run",
+        "tiny.toml",
+        "--duration",
+        "0.1",
+        "--no-rrd",
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn bad_input_exits_non_zero_with_a_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    expect_failure(
+        &["run", "nowhere.toml"],
+        dir.path(),
+        &["nowhere.toml", "no such file"],
+    );
+    std::fs::write(
+        dir.path().join("bad.toml"),
+        ROOM.replace("seed = 3", "seed = 3\nspeed = 2"),
+    )
+    .unwrap();
+    expect_failure(&["run", "bad.toml"], dir.path(), &["bad.toml:4:", "speed"]);
+    std::fs::write(
+        dir.path().join("bad2.toml"),
+        ROOM.replace(
+            "[robots.sensors.encoder]",
+            "[robots.sensors.encoder]\nticks_per_rev = -5",
+        ),
+    )
+    .unwrap();
+    expect_failure(
+        &["run", "bad2.toml"],
+        dir.path(),
+        &["bad2.toml:", "ticks_per_rev"],
+    );
+    std::fs::write(dir.path().join("bad3.toml"), "duration = [").unwrap();
+    expect_failure(&["run", "bad3.toml"], dir.path(), &["bad3.toml:1:"]);
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    expect_failure(
+        &["run", "tiny.toml", "--duration", "-1"],
+        dir.path(),
+        &["--duration"],
+    );
+    expect_failure(
+        &[
+            "run",
+            "tiny.toml",
+            "--rrd",
+            "no/such/dir/x.rrd",
+            "--duration",
+            "0.1",
+        ],
+        dir.path(),
+        &["x.rrd"],
+    );
+}
+
+#[test]
+fn scenarios_lists_the_bundled_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = sim(&["scenarios"], dir.path());
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        s.contains("hospital_patrol") && s.contains("maze_run"),
+        "{s}"
+    );
+    assert!(!s.contains("invalid"), "{s}");
+}
+
+/// Output into a pipe nobody reads (`sim scenarios | head -0`): the process ends by SIGPIPE, as
+/// Unix tools do, not with a panic about a failed print.
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_sim"))
+        .arg("scenarios")
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(
+        out.status.signal(),
+        Some(libc::SIGPIPE),
+        "{:?} {stderr}",
+        out.status
+    );
+}
