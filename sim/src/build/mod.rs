@@ -24,11 +24,11 @@ use systems::localization::{
 };
 use systems::mapping::{GraphSlam, MappingPlugin, RbpfSlam, ScanToMapSlam};
 use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
+use systems::raycast::{Door, Doors, StaticWorld};
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
     SonarTruth, Sonars,
 };
-use systems::raycast::{Door, Doors, StaticWorld};
 
 /// A world ready to step.
 pub struct SimWorld {

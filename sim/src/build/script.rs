@@ -9,8 +9,8 @@ use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::SimClock;
 use systems::localization::LocalizationMap;
 use systems::navigation::Behaviour;
-use systems::sensors::{Encoder, Laser, Sonars};
 use systems::raycast::{Doors, StaticWorld};
+use systems::sensors::{Encoder, Laser, Sonars};
 
 #[derive(Resource)]
 pub struct EventQueue {

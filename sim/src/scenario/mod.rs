@@ -22,14 +22,12 @@ pub mod slam_file;
 pub mod sonar;
 
 pub use error::ScenarioError;
-pub use localizers::{LocalizerConfig, LocalizerKind};
-pub use navigation::NavConfig;
-pub use people::PersonConfig;
-pub use sonar::SonarConfig;
 pub use load::{
     DEFAULT_SCENARIO, assets_dir, bundled_scenarios, find_scenario, load_scenario, parse_scenario,
     scenario_arg, scenario_path,
 };
-pub use model::{
-    DoorConfig, Event, EventAction, RecordConfig, RobotConfig, Scenario, SensorName,
-};
+pub use localizers::{LocalizerConfig, LocalizerKind};
+pub use model::{DoorConfig, Event, EventAction, RecordConfig, RobotConfig, Scenario, SensorName};
+pub use navigation::NavConfig;
+pub use people::PersonConfig;
+pub use sonar::SonarConfig;

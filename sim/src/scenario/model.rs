@@ -128,7 +128,6 @@ pub enum EventAction {
     },
 }
 
-
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(rename_all = "snake_case")]
 pub enum SensorName {
@@ -136,4 +135,3 @@ pub enum SensorName {
     Encoder,
     Sonar,
 }
-

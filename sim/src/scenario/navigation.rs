@@ -2,10 +2,10 @@
 //! task queue. Places in tasks resolve through the map's places file; every value is checked
 //! with the robot and key named in the error.
 
-use super::localizers::LocalizerConfig;
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
 use super::error::KeyPath;
+use super::localizers::LocalizerConfig;
 use serde::Deserialize;
 use systems::body::{Footprint, Kinematics};
 use systems::core::Pose2;

@@ -2,9 +2,9 @@
 //! (`[places.<name>] pose = [x, y, yaw]`) and doors (`[doors.<name>] from, to, thickness`), with
 //! errors naming the places file and key.
 
-use super::model::DoorConfig;
 use super::check::{Checker, R};
 use super::error::{ErrorContext, KeyPath};
+use super::model::DoorConfig;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -4,12 +4,12 @@
 use super::check::{Checker, PointOrPlace, R, check_name};
 use super::error::{ErrorContext, KeyPath};
 use super::file::*;
+use super::model::{RecordConfig, RobotConfig, Scenario};
 use super::outdoor::RoadsConfig;
 use super::outdoor_robot;
 use super::outdoor_robot::RouteConfig;
 use super::sensors::{resolve_encoder, resolve_laser};
 use super::sonar::SonarConfig;
-use super::model::{RecordConfig, RobotConfig, Scenario};
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::body::{Ackermann, DiffDrive, Footprint, Kinematics};

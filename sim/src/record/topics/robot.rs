@@ -1,11 +1,11 @@
 //! One robot's topics: which it gets (one per sensor it carries), their channels, frames and
 //! periods, its static transforms, and what the recorder remembers between ticks.
 
-use serde::{Deserialize, Serialize};
 use super::convert::transform;
 use crate::record::mcap::messages::*;
 use crate::record::mcap::{Channel, McapRecorder, RosMessage};
 use bevy_ecs::prelude::*;
+use serde::{Deserialize, Serialize};
 use systems::core::{Pose2, RobotId, RobotIndex};
 use systems::localization::{OdometryModel, WheelOdometry};
 use systems::sensors::{Camera, Compass, Encoder, Gps, Laser, Sonars};

@@ -33,8 +33,8 @@ mod file;
 mod ops;
 
 use file::FileWriter;
-use ops::{Batch, Op, Reply};
 pub(crate) use ops::Output;
+use ops::{Batch, Op, Reply};
 pub use ops::{DEFAULT_FLUSH_PERIOD_NS, MESSAGE_ENCODING, McapStats};
 
 /// The MCAP profile of ROS 2 recordings.
@@ -45,7 +45,6 @@ const BATCH_BYTES: usize = 256 * 1024;
 const BATCH_OPS: usize = 2048;
 /// Batches waiting for the writer thread at most (the caller waits when there are more).
 pub const QUEUED_BATCHES: usize = 8;
-
 
 /// A registered topic whose messages are of type `T`.
 pub struct Channel<T> {
@@ -67,7 +66,6 @@ impl<T> Channel<T> {
     }
 }
 
-
 /// An MCAP file being written. See the module doc.
 pub struct McapRecorder {
     path: PathBuf,
@@ -84,8 +82,6 @@ pub struct McapRecorder {
     spare: Mutex<mpsc::Receiver<Batch>>,
     worker: Option<JoinHandle<anyhow::Result<McapStats>>>,
 }
-
-
 
 impl McapRecorder {
     /// Creates (truncates) `path` and writes the MCAP header with `profile` (use
