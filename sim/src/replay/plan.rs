@@ -2,7 +2,7 @@
 //! seed and length of the recorded run; otherwise `--scenario`), with `--set` overrides
 //! applied as `sim batch` applies them, the robots to replay and each one's readings.
 
-use super::ReplayArgs;
+use super::args::ReplayArgs;
 use super::source::{RobotFeed, TimeBase, TopicFlags, first_stamp, robot_feed};
 use crate::batch::sets::{Source, plan_sets};
 use crate::record::mcap::McapRecording;
