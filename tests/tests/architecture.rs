@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use tests::module_graph::ModuleGraph;
 
 /// `systems`' folders, lowest level first (`systems/ARCHITECTURE.md`, "Layers of `systems`"):
-/// core ← world ← raycast, body ← sensors ← matching ← localization ← mapping, navigation, eval. Folders of one level may import
-/// each other one way only (that is checked as a cycle between the folders).
+/// core ← world ← raycast, body ← sensors ← matching ← localization ← mapping, navigation, eval.
+/// Folders of one level may import each other one way only (that is checked as a cycle between the folders).
 const SYSTEMS_LEVELS: &[&[&str]] = &[
     &["core"],
     &["world"],
