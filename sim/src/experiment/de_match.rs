@@ -48,7 +48,6 @@ use systems::matching::{
 };
 
 /// Options of `sim experiment de-match`.
-/// Options of `sim experiment de-match`.
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct DeMatchOptions {
     /// One JSON object per row, one per line.
@@ -436,42 +435,9 @@ fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<Vec<Row>> {
         .par_iter()
         .map(|p| (p.reference(&data).points(), p.current(&data).points()))
         .collect();
-
-    // all alignments, flattened: (method, pair, repeat)
-    let mut jobs: Vec<(usize, usize, usize)> = Vec::new();
-    for (mi, m) in methods.iter().enumerate() {
-        if m.brute_subset {
-            jobs.extend(brute.iter().map(|&p| (mi, p, 0)));
-        } else {
-            for p in 0..pairs.len() {
-                jobs.extend((0..repeats).map(|r| (mi, p, r)));
-            }
-        }
-    }
-    // the slow brute-force jobs first, so they do not straggle at the end
-    jobs.sort_by_key(|&(mi, p, r)| (!methods[mi].brute_subset, p, mi, r));
+    let jobs = plan_jobs(&methods, &brute, pairs.len(), repeats);
     if !o.json {
-        let speeds: Vec<String> = data
-            .iter()
-            .map(|d| {
-                let n: usize = d.streams.iter().map(|s| s.scans.len()).sum();
-                let mut s = format!(
-                    "{}: {} scans of {} robots, mean speed {:.2} m/s",
-                    d.name,
-                    n,
-                    d.streams.len(),
-                    d.mean_speed
-                );
-                if !d.replaced_lasers.is_empty() {
-                    s += &format!(
-                        " (laser replaced by a SICK LMS100 on {})",
-                        d.replaced_lasers.join(", ")
-                    );
-                }
-                s
-            })
-            .collect();
-        eprintln!("{}", speeds.join("; "));
+        eprintln!("{}", describe_scans(&data));
         eprintln!(
             "{} protocol: {} pairs × {} repeat(s), {} methods, brute-force Euclidean on {} pairs; \
              {} alignments on {threads} threads",
@@ -483,41 +449,13 @@ fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<Vec<Row>> {
             jobs.len()
         );
     }
-    let bar = if o.json {
-        ProgressBar::hidden()
-    } else {
-        let b = ProgressBar::new(jobs.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template(
-                "{bar:40.cyan/blue} {pos}/{len} alignments  [{elapsed_precise} < {eta}]",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b
-    };
+    let bar = progress_bar(o.json, jobs.len());
     let results: Vec<anyhow::Result<Alignment>> = jobs
         .par_iter()
         .map(|&(mi, p, r)| {
-            let m = &methods[mi];
-            let seed = stream_seed(
-                o.seed,
-                &format!("experiment/de-match/{}", m.name),
-                &format!("{p}/{r}"),
-            );
-            let config = m.config.clone().with_seed(seed);
-            let (a, b) = &points[p];
-            let out = match_scans(a, b, &config)
-                .map_err(|e| anyhow::anyhow!("{}, pair {p}: {e}", m.name))?;
+            let out = align(&methods[mi], o.seed, p, r, &points[p], &pairs[p]);
             bar.inc(1);
-            Ok(Alignment {
-                pair: p,
-                repeat: r,
-                found: out.transform,
-                error: TransformError::of(&out.transform, &pairs[p].truth),
-                fitness: out.fitness,
-                evaluations: out.evaluations,
-                ms: out.elapsed.as_secs_f64() * 1e3,
-            })
+            out
         })
         .collect();
     bar.finish_and_clear();
@@ -526,35 +464,138 @@ fn run_in_pool(o: &DeMatchOptions, threads: usize) -> anyhow::Result<Vec<Row>> {
         per_method[mi].push(r?);
     }
     if o.list_wrong {
-        for (m, res) in methods.iter().zip(&per_method) {
-            for a in res.iter().filter(|a| !a.error.right()) {
-                let p = &pairs[a.pair];
-                let (ra, rb) = (p.reference(&data), p.current(&data));
-                eprintln!(
-                    "wrong: {} | {} scans {} -> {} ({}, {} steps, repeat {}) | truth ({:.3}, {:.3}, {:.1}°) found ({:.3}, {:.3}, {:.1}°) fitness {:.3}",
-                    m.name,
-                    data[p.scenario].name,
-                    ra.index,
-                    rb.index,
-                    ra.robot,
-                    p.steps,
-                    a.repeat,
-                    p.truth.x,
-                    p.truth.y,
-                    p.truth.theta.to_degrees(),
-                    a.found.x,
-                    a.found.y,
-                    a.found.theta.to_degrees(),
-                    a.fitness
-                );
-            }
-        }
+        list_wrong(&methods, &per_method, &pairs, &data);
     }
     Ok(methods
         .iter()
         .zip(&per_method)
         .map(|(m, res)| summarise(m, protocol, &pairs, &names, res, o.seed))
         .collect())
+}
+
+/// Every alignment of the experiment as (method, pair, repeat): the brute-force methods on the
+/// `brute` pairs once, the others on every pair `repeats` times; the slow brute-force jobs
+/// first, so they do not straggle at the end.
+fn plan_jobs(
+    methods: &[Method],
+    brute: &[usize],
+    pairs: usize,
+    repeats: usize,
+) -> Vec<(usize, usize, usize)> {
+    let mut jobs: Vec<(usize, usize, usize)> = Vec::new();
+    for (mi, m) in methods.iter().enumerate() {
+        if m.brute_subset {
+            jobs.extend(brute.iter().map(|&p| (mi, p, 0)));
+        } else {
+            for p in 0..pairs {
+                jobs.extend((0..repeats).map(|r| (mi, p, r)));
+            }
+        }
+    }
+    jobs.sort_by_key(|&(mi, p, r)| (!methods[mi].brute_subset, p, mi, r));
+    jobs
+}
+
+/// One alignment: `method` on pair `p` (its points and truth), repeat `r`, with the matcher
+/// seed of (seed, method, pair, repeat).
+fn align(
+    method: &Method,
+    seed: u64,
+    p: usize,
+    r: usize,
+    (a, b): &PointPair,
+    pair: &Pair,
+) -> anyhow::Result<Alignment> {
+    let seed = stream_seed(
+        seed,
+        &format!("experiment/de-match/{}", method.name),
+        &format!("{p}/{r}"),
+    );
+    let config = method.config.clone().with_seed(seed);
+    let out = match_scans(a, b, &config)
+        .map_err(|e| anyhow::anyhow!("{}, pair {p}: {e}", method.name))?;
+    Ok(Alignment {
+        pair: p,
+        repeat: r,
+        found: out.transform,
+        error: TransformError::of(&out.transform, &pair.truth),
+        fitness: out.fitness,
+        evaluations: out.evaluations,
+        ms: out.elapsed.as_secs_f64() * 1e3,
+    })
+}
+
+/// One line on the captured scans: per scenario the scans, robots, mean speed and replaced
+/// lasers.
+fn describe_scans(data: &[ScenarioScans]) -> String {
+    let speeds: Vec<String> = data
+        .iter()
+        .map(|d| {
+            let n: usize = d.streams.iter().map(|s| s.scans.len()).sum();
+            let mut s = format!(
+                "{}: {} scans of {} robots, mean speed {:.2} m/s",
+                d.name,
+                n,
+                d.streams.len(),
+                d.mean_speed
+            );
+            if !d.replaced_lasers.is_empty() {
+                s += &format!(
+                    " (laser replaced by a SICK LMS100 on {})",
+                    d.replaced_lasers.join(", ")
+                );
+            }
+            s
+        })
+        .collect();
+    speeds.join("; ")
+}
+
+/// The alignments' progress bar on stderr (hidden with `--json`).
+fn progress_bar(json: bool, alignments: usize) -> ProgressBar {
+    if json {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new(alignments as u64);
+    b.set_style(
+        ProgressStyle::with_template(
+            "{bar:40.cyan/blue} {pos}/{len} alignments  [{elapsed_precise} < {eta}]",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b
+}
+
+/// `--list-wrong`: every wrong alignment on stderr, with its scans, truth and answer.
+fn list_wrong(
+    methods: &[Method],
+    per_method: &[Vec<Alignment>],
+    pairs: &[Pair],
+    data: &[ScenarioScans],
+) {
+    for (m, res) in methods.iter().zip(per_method) {
+        for a in res.iter().filter(|a| !a.error.right()) {
+            let p = &pairs[a.pair];
+            let (ra, rb) = (p.reference(data), p.current(data));
+            eprintln!(
+                "wrong: {} | {} scans {} -> {} ({}, {} steps, repeat {}) | truth ({:.3}, {:.3}, {:.1}°) found ({:.3}, {:.3}, {:.1}°) fitness {:.3}",
+                m.name,
+                data[p.scenario].name,
+                ra.index,
+                rb.index,
+                ra.robot,
+                p.steps,
+                a.repeat,
+                p.truth.x,
+                p.truth.y,
+                p.truth.theta.to_degrees(),
+                a.found.x,
+                a.found.y,
+                a.found.theta.to_degrees(),
+                a.fitness
+            );
+        }
+    }
 }
 
 /// The text table of the rows.

@@ -4,9 +4,8 @@
 //! Between parallel sections the pool keeps all but one of its workers spinning for a short
 //! while (see [`KernelPool::install`]): a tick alternates parallel kernels with about a
 //! millisecond of serial work (the rapier2d step), long enough for rayon's idle workers to go to
-//! sleep, and waking a sleeping worker took about 0.4 ms on the 2-core CI machine (a virtual
-//! machine), per parallel section. Measured in `sim bench swarm` (1000 robots, 180 beams):
-//! 0.60 s → 0.50 s for 5 simulated seconds.
+//! sleep, and waking a sleeping worker costs a fraction of a millisecond per parallel section
+//! (sim/docs/benchmarks.md, "Swarm").
 
 use bevy_ecs::prelude::Resource;
 use std::sync::Arc;
