@@ -4,7 +4,7 @@
 pub mod outdoor;
 pub mod script;
 
-use crate::build::script::{EventQueue, fire_events};
+use crate::build::script::{EventQueue, ScriptPlugin};
 use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
 use bevy_ecs::prelude::*;
 use systems::body::{
@@ -12,7 +12,7 @@ use systems::body::{
     PhysicsPlugin, TruePose, TrueTwist, Walker,
 };
 use systems::core::{
-    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimRng, SimSet, new_schedule, stream_rng,
+    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimRng, new_schedule, stream_rng,
 };
 use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome, RobotMetrics};
 use systems::localization::de_filter::DeFilter;
@@ -153,9 +153,9 @@ pub fn build_world_with(
     ));
 
     let mut schedule = new_schedule();
-    schedule.add_systems(fire_events.in_set(SimSet::Script));
     let plugins: &[&dyn SimPlugin] = match mode {
         BuildMode::Live => &[
+            &ScriptPlugin,
             &NavigationPlugin,
             &PeoplePlugin,
             &PhysicsPlugin,
@@ -164,7 +164,12 @@ pub fn build_world_with(
             &MappingPlugin,
             &EvalPlugin,
         ],
-        BuildMode::Replay => &[&LocalizationPlugin, &MappingPlugin, &EvalPlugin],
+        BuildMode::Replay => &[
+            &ScriptPlugin,
+            &LocalizationPlugin,
+            &MappingPlugin,
+            &EvalPlugin,
+        ],
     };
     for p in plugins {
         p.build(&mut world, &mut schedule);

@@ -6,7 +6,7 @@
 use crate::scenario::{Event, EventAction, RobotConfig, SensorName};
 use bevy_ecs::prelude::*;
 use systems::body::{Physics, PhysicsBody, TruePose};
-use systems::core::SimClock;
+use systems::core::{SimClock, SimPlugin, SimSet};
 use systems::localization::LocalizationMap;
 use systems::navigation::Behaviour;
 use systems::raycast::{Doors, StaticWorld};
@@ -38,6 +38,15 @@ impl EventQueue {
             next: 0,
             fired: Vec::new(),
         }
+    }
+}
+
+/// The scenario's script: [`fire_events`] in the Script set (the world holds the [`EventQueue`]).
+pub struct ScriptPlugin;
+
+impl SimPlugin for ScriptPlugin {
+    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
+        schedule.add_systems(fire_events.in_set(SimSet::Script));
     }
 }
 

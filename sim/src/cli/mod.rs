@@ -6,6 +6,7 @@ pub mod bench;
 pub mod experiment;
 pub mod run;
 pub mod scans;
+pub mod schedule;
 
 use crate::scenario::{bundled_scenarios, load_scenario};
 use clap::{Parser, Subcommand};
@@ -38,6 +39,9 @@ pub enum Command {
     Slam(crate::log_slam::SlamArgs),
     /// List the bundled scenarios.
     Scenarios,
+    /// Print the tick order of a scenario's run (or, with --replay, of its replay): the systems
+    /// of each set in the order they run, with every output a run can have.
+    Schedule(schedule::ScheduleArgs),
     /// Capture laser scans with their true sensor poses into a SCANS file (CSV, see the
     /// recordings documentation). Localizers are not run: they never influence motion or
     /// sensing.
@@ -83,6 +87,7 @@ pub fn dispatch(cmd: Command) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        Command::Schedule(a) => schedule::schedule_command(&a),
         Command::Scans(a) => scans::scans_command(a),
         Command::Match(o) => crate::experiment::match_pair::run_match(&o),
         Command::Experiment { which } => experiment::experiment_command(which),

@@ -11,7 +11,7 @@
 
 use bevy_ecs::prelude::*;
 use std::path::{Path, PathBuf};
-use systems::core::{Pose2, RobotId, RobotIndex};
+use systems::core::{Pose2, RobotId, RobotIndex, SimPlugin, SimSet};
 use systems::localization::{Filter, Localizers};
 use systems::mapping::{LogOddsMap, MapQuality, OccupancyParams, map_quality};
 use systems::sensors::{Laser, LaserScans, LaserTruth};
@@ -48,6 +48,27 @@ impl KnownPoseMaps {
             .collect();
         maps.sort_by_key(|(i, _)| *i);
         KnownPoseMaps { maps }
+    }
+}
+
+/// Whether a robot of a built world can map: every map (a SLAM system's or a known-pose map)
+/// is made from a laser's scans.
+pub fn can_map(world: &mut World) -> bool {
+    world.query::<&Laser>().iter(world).next().is_some()
+}
+
+/// `--save-map`: the known-pose maps of the world's robots ([`KnownPoseMaps::new`]) and
+/// [`map_known_poses`] in the Record set.
+pub struct KnownPoseMapsPlugin {
+    /// The maps' resolution (m).
+    pub resolution: f64,
+}
+
+impl SimPlugin for KnownPoseMapsPlugin {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        let maps = KnownPoseMaps::new(world, self.resolution);
+        world.insert_resource(maps);
+        schedule.add_systems(map_known_poses.in_set(SimSet::Record));
     }
 }
 

@@ -14,11 +14,13 @@
 //! follows a few seconds of other messages); readers order them by their log time.
 
 use super::rrd::RrdRecorder;
+use super::rrd::outdoor::record_outdoor;
 use bevy_ecs::prelude::*;
+use std::cell::Cell;
 use std::collections::VecDeque;
 use std::sync::{Arc, Mutex, mpsc};
 use std::thread::JoinHandle;
-use systems::core::{RobotId, RobotIndex, SimClock};
+use systems::core::{RobotId, RobotIndex, SimClock, SimPlugin, SimSet};
 use systems::navigation::road_recognition::{RoadDetection, RoadDetector, draw_detection};
 use systems::sensors::camera::{CameraFrame, CameraImage, FrameView, GroundRays, Palette};
 use systems::sensors::{Camera, CameraImages};
@@ -157,6 +159,11 @@ impl RecordedFrames {
         }
     }
 
+    /// What the recorders want of each frame.
+    pub fn outputs(&self) -> FrameOutputs {
+        self.outputs
+    }
+
     /// The run is over: the frames still being rendered, oldest first; the worker ends.
     pub fn finish(mut self) -> (Vec<RecordedFrame>, Option<String>) {
         self.ready.clear();
@@ -169,6 +176,51 @@ impl RecordedFrames {
                 .get_or_insert_with(|| "the camera frame worker panicked".into());
         }
         (std::mem::take(&mut self.ready), self.error.take())
+    }
+}
+
+/// The camera frames of the recordings as a plugin of the tick: [`collect_frames`] in the Record
+/// set, then (for the .rrd) [`record_frames_rrd`] after the .rrd's other recorders. The MCAP
+/// writer, built after this plugin, orders itself between the two
+/// ([`crate::record::topics::McapPlugin`]).
+pub struct FramesPlugin {
+    frames: Cell<Option<RecordedFrames>>,
+}
+
+impl FramesPlugin {
+    /// Starts the frame worker when a robot of `world` carries a camera and a recording wants
+    /// frames (None otherwise). `camera_rate`: recorded frames per second and camera.
+    pub fn new(
+        world: &mut World,
+        camera_rate: f64,
+        outputs: FrameOutputs,
+    ) -> anyhow::Result<Option<Self>> {
+        let cameras = world.query::<&Camera>().iter(world).count();
+        if cameras == 0 || !(outputs.raw || outputs.jpeg) {
+            return Ok(None);
+        }
+        Ok(Some(FramesPlugin {
+            frames: Cell::new(Some(RecordedFrames::new(camera_rate, outputs)?)),
+        }))
+    }
+}
+
+impl SimPlugin for FramesPlugin {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        let frames = self.frames.take().expect("FramesPlugin is built once");
+        let jpeg = frames.outputs.jpeg;
+        world.insert_resource(frames);
+        let collect = collect_frames.in_set(SimSet::Record);
+        if jpeg {
+            // the .rrd's images after the frames are collected and after the .rrd's other
+            // recorders (all write the recorder)
+            let images = record_frames_rrd
+                .in_set(SimSet::Record)
+                .after(record_outdoor);
+            schedule.add_systems((collect, images).chain());
+        } else {
+            schedule.add_systems(collect);
+        }
     }
 }
 

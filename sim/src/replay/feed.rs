@@ -5,8 +5,9 @@
 
 use super::source::RobotFeed;
 use bevy_ecs::prelude::*;
+use std::cell::Cell;
 use systems::body::TruePose;
-use systems::core::{Pose2, SimClock};
+use systems::core::{Pose2, SimClock, SimPlugin, SimSet};
 use systems::localization::WheelOdometry;
 use systems::sensors::{EncoderReadings, Laser, LaserScans, LaserTruth};
 
@@ -35,6 +36,26 @@ impl FedRobot {
 #[derive(Resource)]
 pub struct ReplayFeed {
     pub robots: Vec<FedRobot>,
+}
+
+/// The recorded readings and [`feed_recorded`] in the Sense set.
+pub struct ReplayFeedPlugin {
+    feed: Cell<Option<ReplayFeed>>,
+}
+
+impl ReplayFeedPlugin {
+    pub fn new(feed: ReplayFeed) -> Self {
+        ReplayFeedPlugin {
+            feed: Cell::new(Some(feed)),
+        }
+    }
+}
+
+impl SimPlugin for ReplayFeedPlugin {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        world.insert_resource(self.feed.take().expect("ReplayFeedPlugin is built once"));
+        schedule.add_systems(feed_recorded.in_set(SimSet::Sense));
+    }
 }
 
 /// The items of `list` from `*next` on with a time up to `end`; advances `*next` past them.

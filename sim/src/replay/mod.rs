@@ -28,20 +28,20 @@ mod plan;
 mod source;
 
 pub use args::ReplayArgs;
-pub use feed::{ReplayFeed, feed_recorded};
+pub use feed::{ReplayFeed, ReplayFeedPlugin, feed_recorded};
 pub use plan::{ReplayPlan, plan};
 pub use source::{RobotFeed, TopicFlags};
 
-use crate::build::{BuildMode, build_world_with};
+use crate::build::{BuildMode, SimWorld, build_world_with};
 use crate::record::mcap::McapRecording;
 use crate::run::exports::RunExports;
 use crate::run::report::report_run;
 use crate::run::{RunOptions, RunOutput, run_built};
-use bevy_ecs::prelude::*;
+use crate::scenario::Scenario;
 use feed::FedRobot;
 use std::path::PathBuf;
 use systems::body::TruePose;
-use systems::core::SimSet;
+use systems::core::SimPlugin;
 use systems::localization::{OdometryModel, WheelOdometry};
 use systems::sensors::EncoderReadings;
 
@@ -51,10 +51,18 @@ pub fn replay(
     opts: &RunOptions,
     exports: &RunExports,
 ) -> anyhow::Result<RunOutput> {
+    let (sim, scenario) = build_replay(plan, opts.threads)?;
+    run_built(sim, &scenario, opts, exports)
+}
+
+/// The world of a replay of `plan` (with a kernel pool of `threads` workers): built for
+/// [`BuildMode::Replay`], with the recorded readings fed in the Sense set
+/// ([`ReplayFeedPlugin`]); and the scenario it replays.
+pub fn build_replay(plan: ReplayPlan, threads: usize) -> anyhow::Result<(SimWorld, Scenario)> {
     let ReplayPlan {
         scenario, feeds, ..
     } = plan;
-    let mut sim = build_world_with(&scenario, opts.threads, BuildMode::Replay)?;
+    let mut sim = build_world_with(&scenario, threads, BuildMode::Replay)?;
     let mut robots = Vec::with_capacity(feeds.len());
     for (&entity, feed) in sim.robots.iter().zip(feeds) {
         if !feed.odometry.is_empty() {
@@ -74,10 +82,8 @@ pub fn replay(
         }
         robots.push(FedRobot::new(entity, feed));
     }
-    sim.world.insert_resource(ReplayFeed { robots });
-    sim.schedule
-        .add_systems(feed_recorded.in_set(SimSet::Sense));
-    run_built(sim, &scenario, opts, exports)
+    ReplayFeedPlugin::new(ReplayFeed { robots }).build(&mut sim.world, &mut sim.schedule);
+    Ok((sim, scenario))
 }
 
 /// `sim replay`.

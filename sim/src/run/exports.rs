@@ -1,16 +1,15 @@
 //! Files a run exports besides the recording, on request: CARMEN logs (`--carmen-out`,
 //! [`crate::formats::carmen::export`]), maps (`--save-map`, [`crate::formats::maps`]) and an MCAP replay
-//! (`--mcap`, [`crate::record::topics`]). All are observers in the Record set: they never change what
-//! the run computes.
+//! (`--mcap`, [`crate::record::topics`]). All are observers in the Record set (plugins, see
+//! [`crate::run::output_plugins`]): they never change what the run computes.
 
-use crate::build::SimWorld;
-use crate::formats::carmen::export::{CarmenExport, record_carmen};
-use crate::formats::maps::{KnownPoseMaps, SavedMap, map_known_poses, run_maps, save_maps};
-use crate::record::topics::{McapExport, McapWritten, record_mcap};
+use crate::formats::carmen::export::CarmenExport;
+use crate::formats::maps::{SavedMap, run_maps, save_maps};
+use crate::record::topics::{McapExport, McapWritten};
 use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
 use std::path::PathBuf;
-use systems::core::{Pose2, SimSet};
+use systems::core::Pose2;
 
 /// What to export.
 #[derive(Clone, Debug, Default)]
@@ -32,27 +31,6 @@ pub struct Exported {
 }
 
 impl RunExports {
-    /// Adds the exporters to a built world (before the first tick).
-    pub(crate) fn install(&self, sim: &mut SimWorld, scenario: &Scenario) -> anyhow::Result<()> {
-        if let Some(out) = &self.carmen_out {
-            sim.world.insert_resource(CarmenExport::new(scenario, out)?);
-            sim.schedule
-                .add_systems(record_carmen.in_set(SimSet::Record));
-        }
-        if self.save_map.is_some() {
-            let maps = KnownPoseMaps::new(&mut sim.world, scenario.grid.resolution);
-            sim.world.insert_resource(maps);
-            sim.schedule
-                .add_systems(map_known_poses.in_set(SimSet::Record));
-        }
-        if let Some(path) = &self.mcap {
-            let export = McapExport::new(&mut sim.world, scenario, path)?;
-            sim.world.insert_resource(export);
-            sim.schedule.add_systems(record_mcap.in_set(SimSet::Record));
-        }
-        Ok(())
-    }
-
     /// Writes the exports of a finished run. Maps are judged against the scenario's map: SLAM
     /// systems start at the robot's true start pose, so their map frame is the world frame.
     pub(crate) fn finish(

@@ -29,6 +29,7 @@ use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
 
 pub use crate::formats::tum::RobotLocalization;
 pub use capture::ScanCapture;
+pub use outputs::output_plugins;
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {

@@ -1,23 +1,67 @@
 //! A run's outputs: the Rerun recording, the camera frames both recordings share, and the exports
-//! asked for (CARMEN logs, maps, the MCAP replay) join the schedule's Record set before the first
-//! tick and are finished after the last one. They only observe: the run computes the same with
-//! or without them.
+//! asked for (CARMEN logs, maps, the MCAP replay) join the schedule's Record set as plugins
+//! ([`output_plugins`]) before the first tick and are finished after the last one. They only
+//! observe: the run computes the same with or without them.
 
 use crate::build::SimWorld;
-use crate::record::frames::{
-    FrameOutputs, RecordedFrames, collect_frames, log_frames_rrd, record_frames_rrd,
-};
-use crate::record::rrd::outdoor::{OutdoorRecording, record_outdoor};
-use crate::record::rrd::slam::{SlamRecording, record_slam, record_slam_final};
-use crate::record::topics::{McapExport, record_mcap};
-use crate::record::{RrdRecorder, record_navigation, record_rrd};
+use crate::formats::carmen::export::{CarmenExport, CarmenExportPlugin};
+use crate::formats::maps::{KnownPoseMapsPlugin, can_map};
+use crate::record::frames::{FrameOutputs, FramesPlugin, RecordedFrames, log_frames_rrd};
+use crate::record::rrd::slam::record_slam_final;
+use crate::record::rrd::{RrdPlugin, RrdRecorder};
+use crate::record::topics::{McapExport, McapPlugin};
 use crate::run::exports::{Exported, RunExports};
 use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
 use std::path::Path;
-use systems::core::{SimClock, SimSet};
+use systems::core::{SimClock, SimPlugin};
 use systems::localization::{Filter, Localizers};
-use systems::sensors::Camera;
+
+/// The plugins of the outputs asked for, in the order they join the schedule: the .rrd
+/// recording (`rrd`), the CARMEN logs, the known-pose maps, the camera frames when a recording
+/// wants them, the MCAP replay. Their files are opened here, so a bad path fails before the
+/// first tick.
+pub fn output_plugins(
+    world: &mut World,
+    scenario: &Scenario,
+    rrd: Option<&Path>,
+    exports: &RunExports,
+) -> anyhow::Result<Vec<Box<dyn SimPlugin>>> {
+    let mut plugins: Vec<Box<dyn SimPlugin>> = Vec::new();
+    if let Some(path) = rrd {
+        plugins.push(Box::new(RrdPlugin::new(path, scenario)?));
+    }
+    if let Some(out) = &exports.carmen_out {
+        let export = CarmenExport::new(scenario, out)?;
+        plugins.push(Box::new(CarmenExportPlugin::new(export)));
+    }
+    if exports.save_map.is_some() {
+        if !can_map(world) {
+            anyhow::bail!(
+                "--save-map: {} has no robot with a laser or a SLAM system to map with",
+                scenario.source
+            );
+        }
+        plugins.push(Box::new(KnownPoseMapsPlugin {
+            resolution: scenario.grid.resolution,
+        }));
+    }
+    let mcap = match &exports.mcap {
+        Some(path) => Some(McapPlugin::new(world, scenario, path)?),
+        None => None,
+    };
+    let frames = FrameOutputs {
+        raw: mcap.is_some(),
+        jpeg: rrd.is_some(),
+    };
+    if let Some(p) = FramesPlugin::new(world, scenario.record.camera_rate, frames)? {
+        plugins.push(Box::new(p));
+    }
+    if let Some(p) = mcap {
+        plugins.push(Box::new(p));
+    }
+    Ok(plugins)
+}
 
 /// Adds the recording, the camera frames and the exports to a built world.
 pub(crate) fn install(
@@ -26,51 +70,8 @@ pub(crate) fn install(
     rrd: Option<&Path>,
     exports: &RunExports,
 ) -> anyhow::Result<()> {
-    if let Some(path) = rrd {
-        let rec = RrdRecorder::create(path, &scenario.name, &scenario.grid, &scenario.record)?;
-        sim.world.insert_resource(rec);
-        sim.world.insert_resource(SlamRecording::new(
-            scenario.record.scan_rate,
-            scenario.record.slam_rate,
-        ));
-        sim.world.insert_resource(OutdoorRecording::new(
-            scenario.record.rate,
-            scenario.record.particle_rate,
-        ));
-        sim.schedule.add_systems(
-            (record_rrd, record_navigation, record_slam, record_outdoor)
-                .chain()
-                .in_set(SimSet::Record),
-        );
-    }
-    exports.install(sim, scenario)?;
-    install_frames(sim, scenario, rrd.is_some(), exports)
-}
-
-/// Renders whole camera frames for the recordings on a worker thread when a recording is
-/// written and a robot carries a camera ([`crate::record::frames`]).
-fn install_frames(
-    sim: &mut SimWorld,
-    scenario: &Scenario,
-    rrd: bool,
-    exports: &RunExports,
-) -> anyhow::Result<()> {
-    let outputs = FrameOutputs {
-        raw: exports.mcap.is_some(),
-        jpeg: rrd,
-    };
-    let cameras = sim.world.query::<&Camera>().iter(&sim.world).count();
-    if cameras == 0 || !(outputs.raw || outputs.jpeg) {
-        return Ok(());
-    }
-    let frames = RecordedFrames::new(scenario.record.camera_rate, outputs)?;
-    sim.world.insert_resource(frames);
-    let collect = collect_frames.in_set(SimSet::Record).before(record_mcap);
-    if outputs.jpeg {
-        sim.schedule
-            .add_systems((collect, record_frames_rrd.in_set(SimSet::Record)).chain());
-    } else {
-        sim.schedule.add_systems(collect);
+    for p in output_plugins(&mut sim.world, scenario, rrd, exports)? {
+        p.build(&mut sim.world, &mut sim.schedule);
     }
     Ok(())
 }

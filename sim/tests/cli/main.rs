@@ -11,4 +11,5 @@ mod interrupt;
 mod matching;
 mod replay;
 mod run;
+mod schedule;
 mod threads;

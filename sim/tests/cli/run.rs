@@ -156,6 +156,31 @@ fn bad_input_exits_non_zero_with_a_clear_message() {
     );
 }
 
+/// A run asked to save maps of a world with nothing to map fails before its first tick, not
+/// after the whole run.
+#[test]
+fn save_map_without_a_laser_fails_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let no_laser = ROOM.replace("[robots.sensors.laser]\npreset = \"hokuyo_urg04lx\"\n", "");
+    assert_ne!(no_laser, ROOM);
+    std::fs::write(dir.path().join("blind.toml"), no_laser).unwrap();
+    // a day of simulated time: a check after the run would keep this test busy for minutes
+    expect_failure(
+        &[
+            "run",
+            "blind.toml",
+            "--no-rrd",
+            "--save-map",
+            "map",
+            "--duration",
+            "86400",
+        ],
+        dir.path(),
+        &["--save-map", "blind.toml", "no robot with a laser"],
+    );
+    assert!(!dir.path().join("map.pgm").exists());
+}
+
 #[test]
 fn scenarios_lists_the_bundled_ones() {
     let dir = tempfile::tempdir().unwrap();

@@ -20,4 +20,4 @@ pub use ids::{RobotId, RobotIndex};
 pub use pool::KernelPool;
 pub use pose::{Pose2, wrap_angle};
 pub use rng::{SimRng, stream_rng, stream_seed};
-pub use schedule::{SimPlugin, SimSet, new_schedule};
+pub use schedule::{SimPlugin, SimSet, TickSystem, deny_ambiguities, new_schedule, tick_order};

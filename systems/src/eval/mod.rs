@@ -21,13 +21,16 @@ pub struct EvalPlugin;
 
 impl SimPlugin for EvalPlugin {
     fn build(&self, _world: &mut World, schedule: &mut Schedule) {
+        // evaluate_navigation reads the metrics accumulate_metrics writes; the other two share
+        // nothing with them, and are chained too so that the order is the same in every run
         schedule.add_systems(
             (
                 robot_metrics::accumulate_metrics,
+                navigation_metrics::evaluate_navigation,
                 localization_metrics::sample_localization,
                 road_metrics::evaluate_road_runs,
-                navigation_metrics::evaluate_navigation.after(robot_metrics::accumulate_metrics),
             )
+                .chain()
                 .in_set(SimSet::Evaluate),
         );
     }

@@ -64,11 +64,15 @@ impl SimPlugin for NavigationPlugin {
                 .chain()
                 .in_set(SimSet::Plan),
         );
+        // All three write DriveCommand, each for the robots it drives (with a navigator, a road
+        // navigator, or a behaviour): navigators, then road navigators, then behaviours, the order
+        // they ran in before it was explicit. The systems stay in the order they were added in,
+        // which the executor's order of Control's other systems (walk_people) depends on.
         schedule.add_systems(
             (
                 behaviour::drive_behaviours,
-                drive::drive_navigators,
-                road_drive::system::drive_road_navigators,
+                drive::drive_navigators.before(road_drive::system::drive_road_navigators),
+                road_drive::system::drive_road_navigators.before(behaviour::drive_behaviours),
             )
                 .in_set(SimSet::Control),
         );

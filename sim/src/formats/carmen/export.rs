@@ -19,8 +19,9 @@ use crate::formats::carmen::{
 };
 use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
+use std::cell::Cell;
 use std::path::{Path, PathBuf};
-use systems::core::{RobotIndex, wrap_angle};
+use systems::core::{RobotIndex, SimPlugin, SimSet, wrap_angle};
 use systems::localization::WheelOdometry;
 use systems::sensors::{Laser, LaserScans, LaserTruth};
 
@@ -92,6 +93,31 @@ impl CarmenExport {
             written.push(r.path.clone());
         }
         Ok(written)
+    }
+}
+
+/// `--carmen-out`: [`record_carmen`] in the Record set; the logs ([`CarmenExport::new`], which
+/// fails when no robot can be exported) are made before the plugin joins the schedule.
+pub struct CarmenExportPlugin {
+    export: Cell<Option<CarmenExport>>,
+}
+
+impl CarmenExportPlugin {
+    pub fn new(export: CarmenExport) -> Self {
+        CarmenExportPlugin {
+            export: Cell::new(Some(export)),
+        }
+    }
+}
+
+impl SimPlugin for CarmenExportPlugin {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        world.insert_resource(
+            self.export
+                .take()
+                .expect("CarmenExportPlugin is built once"),
+        );
+        schedule.add_systems(record_carmen.in_set(SimSet::Record));
     }
 }
 

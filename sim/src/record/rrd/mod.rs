@@ -32,9 +32,12 @@ pub mod log_slam;
 pub mod navigation;
 pub mod outdoor;
 pub mod path_trace;
+mod plugin;
 pub mod rows;
 pub mod slam;
 pub mod stream;
+
+pub use plugin::RrdPlugin;
 
 use crate::scenario::RecordConfig;
 use belief::Cloud;

@@ -36,7 +36,7 @@ mod record;
 mod robot;
 
 pub use convert::{ACKERMANN_JOINTS, DIFF_DRIVE_JOINTS, ticks_of_angle};
-pub use record::record_mcap;
+pub use record::{McapPlugin, record_mcap};
 pub use robot::TopicInfo;
 
 use crate::record::mcap::messages::{TFMessage, TransformStamped};

@@ -4,13 +4,16 @@
 use super::McapExport;
 use super::convert::*;
 use super::robot::RobotTopics;
-use crate::record::frames::{RecordedFrame, RecordedFrames};
+use crate::record::frames::{RecordedFrame, RecordedFrames, collect_frames, record_frames_rrd};
 use crate::record::mcap::McapRecorder;
 use crate::record::mcap::messages::{Image, Range};
 use crate::record::mcap::stamp_ns;
+use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
+use std::cell::Cell;
+use std::path::Path;
 use systems::body::TruePose;
-use systems::core::{RobotIndex, SimClock};
+use systems::core::{RobotIndex, SimClock, SimPlugin, SimSet};
 use systems::localization::nav_source::NavSource;
 use systems::localization::{Localizers, WheelOdometry};
 use systems::sensors::{CompassReadings, EncoderReadings, GpsReadings, LaserScans, SonarReadings};
@@ -28,6 +31,41 @@ type RobotData<'a> = (
     Option<&'a Localizers>,
     Option<&'a NavSource>,
 );
+
+/// `--mcap`: [`record_mcap`] in the Record set. The file is opened by [`McapPlugin::new`],
+/// before the plugin joins the schedule; built after the camera frames'
+/// ([`crate::record::frames::FramesPlugin`]), whose systems it orders itself with.
+pub struct McapPlugin {
+    export: Cell<Option<McapExport>>,
+}
+
+impl McapPlugin {
+    /// Starts `path` for the robots of `world` (built from `scenario`).
+    pub fn new(world: &mut World, scenario: &Scenario, path: &Path) -> anyhow::Result<Self> {
+        Ok(McapPlugin {
+            export: Cell::new(Some(McapExport::new(world, scenario, path)?)),
+        })
+    }
+}
+
+impl SimPlugin for McapPlugin {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        world.insert_resource(self.export.take().expect("McapPlugin is built once"));
+        let frames = world.get_resource::<RecordedFrames>().map(|f| f.outputs());
+        let system = record_mcap.in_set(SimSet::Record);
+        // With camera frames: after they are collected, and before the .rrd logs its images (both
+        // take this tick's frames, the raw image here, the JPEG there; the order they always
+        // ran in). No order with systems not in the schedule: it would change the executor's
+        // order of the others.
+        match frames {
+            Some(f) if f.jpeg => {
+                schedule.add_systems(system.after(collect_frames).before(record_frames_rrd))
+            }
+            Some(_) => schedule.add_systems(system.after(collect_frames)),
+            None => schedule.add_systems(system),
+        };
+    }
+}
 
 /// Record set, after [`crate::record::frames::collect_frames`]: writes this tick's messages
 /// and the camera frames collected in it (see the module doc of [`crate::record::topics`]).

@@ -3,16 +3,22 @@
 //! their times from the stamps and the periods of `run.json`.
 
 use super::*;
-use crate::build::build_world;
+use crate::build::{SimWorld, build_world};
 use crate::record::mcap::messages::{Imu, JointState, LaserScan, NavSatFix, Odometry};
 use crate::record::mcap::{McapRecording, time_on_grid};
 use crate::scenario::{assets_dir, load_scenario};
-use systems::core::RobotIndex;
+use systems::core::{RobotIndex, SimPlugin};
 use systems::localization::WheelOdometry;
 use systems::sensors::{
     CompassReading, CompassReadings, EncoderReading, EncoderReadings, GpsFix, GpsReadings,
     LaserScan as Scan, LaserScans,
 };
+
+/// Adds the MCAP export of `path` to a built world, as a run with `--mcap` does.
+fn install(sim: &mut SimWorld, sc: &Scenario, path: &Path) -> anyhow::Result<()> {
+    McapPlugin::new(&mut sim.world, sc, path)?.build(&mut sim.world, &mut sim.schedule);
+    Ok(())
+}
 
 /// Everything the first robot's sensors produced, tick by tick.
 #[derive(Default)]
@@ -32,7 +38,7 @@ fn run_live(name: &str, duration: f64, path: &Path) -> (Live, McapWritten) {
         mcap: Some(path.to_path_buf()),
         ..Default::default()
     };
-    exports.install(&mut sim, &sc).unwrap();
+    install(&mut sim, &sc, path).unwrap();
     let mut live = Live::default();
     for _ in 0..(duration / sc.dt).round() as usize {
         sim.step();
@@ -185,7 +191,9 @@ fn an_unwritable_path_is_a_clear_error() {
         mcap: Some("/nonexistent-dir/run.mcap".into()),
         ..Default::default()
     };
-    let e = exports.install(&mut sim, &sc).unwrap_err().to_string();
+    let e = install(&mut sim, &sc, exports.mcap.as_deref().unwrap())
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("/nonexistent-dir/run.mcap: cannot create the MCAP file"),
         "{e}"
@@ -206,7 +214,7 @@ fn a_write_error_during_the_run_is_reported_at_the_end() {
         mcap: Some(full.to_path_buf()),
         ..Default::default()
     };
-    let installed = exports.install(&mut sim, &sc);
+    let installed = install(&mut sim, &sc, full);
     let e = match installed {
         Err(e) => e.to_string(),
         Ok(()) => {
