@@ -1,5 +1,27 @@
-//! The simulator application: scenario files, world building, the run loop, recording, benches
-//! and the `sim` command line.
+//! The simulator: scenario files, building their ECS worlds, stepping them, recording and
+//! exporting runs, batches, benches and the `sim` command line.
+//!
+//! As a library its face is [`Simulation`]: load a scenario (a bundled name, a file or TOML
+//! text), step it, read every robot's state between ticks and command robots; `sim run` drives
+//! the same type.
+//!
+//! ```
+//! use sim::{Command, Simulation};
+//!
+//! let mut s = Simulation::load("hospital_patrol").duration(1.0).threads(1).build()?;
+//! s.run_for(0.5)?;
+//! let r1 = s.robot("r1")?;
+//! assert!(r1.scan().is_some() && r1.odometry().is_some());
+//! let home = r1.pose();
+//! s.command("r2", Command::Teleport(home))?; // r2 is kidnapped at the next tick
+//! let done = s.run()?;
+//! assert_eq!(done.summary.robots.len(), 4);
+//! # anyhow::Ok(())
+//! ```
+//!
+//! Next: the guide (sim/docs/scripting.md), [`run::RobotView`] for what can be read,
+//! [`Command`] for what can be told, and the `systems` crate for the components and systems
+//! themselves.
 
 pub mod batch;
 pub mod bench;
@@ -16,5 +38,8 @@ pub mod scenario;
 pub mod stats;
 
 pub use run::exports::RunExports;
-pub use run::{RunOptions, RunOutput, run_scenario, run_scenario_exporting};
+pub use run::{
+    Command, Finished, RunOptions, RunOutput, SimError, Simulation, SimulationBuilder,
+    run_scenario, run_scenario_exporting,
+};
 pub use scenario::{Scenario, load_scenario, parse_scenario};

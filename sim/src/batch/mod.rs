@@ -12,7 +12,6 @@ pub mod args;
 pub mod manifest;
 pub mod merge;
 pub mod output;
-pub mod params;
 pub mod runner;
 pub mod sets;
 
@@ -82,7 +81,7 @@ impl BatchReport {
 pub struct Batch {
     pub name: String,
     pub keys: Vec<String>,
-    pub sets: Vec<Vec<params::Override>>,
+    pub sets: Vec<Vec<crate::scenario::overrides::Override>>,
     /// Per set, its scenario (None: no job of this shard uses it).
     pub scenarios: Vec<Option<Result<Scenario, String>>>,
     pub jobs: Vec<runner::Job>,
@@ -97,7 +96,7 @@ pub fn prepare(a: &BatchArgs) -> anyhow::Result<Batch> {
     let shard = a.shard.as_deref().map(args::parse_shard).transpose()?;
     let plan = sets::plan_sets(&a.sets, &a.sweeps, &a.zips)?;
     let total = runner::total_runs(plan.sets.len(), &seeds)?;
-    let source = sets::Source::load(&scenario_path(Some(&a.scenario))?)?;
+    let source = crate::scenario::source::Source::load(&scenario_path(Some(&a.scenario))?)?;
     let duration = a.duration.map(check_duration).transpose()?;
     let (shard_k, shards) = shard.unwrap_or((0, 1));
     let manifest = manifest::Manifest {

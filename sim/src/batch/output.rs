@@ -4,8 +4,8 @@
 //! (`fleet.*`). Written as `runs.csv` (header: the union of the rows' keys, in order of first
 //! appearance) and `runs.jsonl` (one object per line, keys in the same order).
 
-use super::params::Override;
 use crate::run::summary::Summary;
+use crate::scenario::overrides::Override;
 use serde_json::{Map, Value as Json, json};
 use std::io::Write;
 use std::path::Path;

@@ -4,11 +4,18 @@
 //! loaded and validated as a scenario file is.
 
 use super::args::{split_key_value, split_values};
-use super::params::{Override, blame};
 use super::runner::MAX_RUNS;
-use crate::scenario::{Scenario, parse_scenario};
-use std::path::{Path, PathBuf};
-use toml_edit::DocumentMut;
+use crate::scenario::overrides::Override;
+
+/// One override of a batch (or replay) flag; the seed is not among them: it comes from
+/// `--seeds` (`--seed` in a replay).
+fn batch_override(flag: &'static str, key: &str, text: &str) -> anyhow::Result<Override> {
+    let o = Override::new(flag, key, text)?;
+    if o.is_seed() {
+        anyhow::bail!("{flag} {key}={text}: the seed of each run comes from --seeds");
+    }
+    Ok(o)
+}
 
 /// The overrides of every parameter set, in set order, and the keys that vary or are set.
 #[derive(Clone, Debug)]
@@ -23,7 +30,7 @@ fn overrides_of(flag: &'static str, arg: &str) -> anyhow::Result<Vec<Override>> 
     let (k, v) = split_key_value(flag, arg)?;
     split_values(flag, arg, v)?
         .iter()
-        .map(|v| Override::new(flag, k, v))
+        .map(|v| batch_override(flag, k, v))
         .collect()
 }
 
@@ -32,7 +39,7 @@ pub fn plan_sets(sets: &[String], sweeps: &[String], zips: &[String]) -> anyhow:
     let mut fixed = Vec::new();
     for s in sets {
         let (k, v) = split_key_value("--set", s)?;
-        fixed.push(Override::new("--set", k, v)?);
+        fixed.push(batch_override("--set", k, v)?);
     }
     // axes: each a list of points, each point a list of overrides
     let mut axes: Vec<Vec<Vec<Override>>> = Vec::new();
@@ -111,78 +118,6 @@ pub fn plan_sets(sets: &[String], sweeps: &[String], zips: &[String]) -> anyhow:
             }
             at[d] = 0;
         }
-    }
-}
-
-/// The scenario file every set starts from.
-pub struct Source {
-    pub path: PathBuf,
-    pub label: String,
-    base_dir: PathBuf,
-    stem: String,
-    doc: DocumentMut,
-    /// The file as it is (for sets without overrides).
-    pub plain: Scenario,
-}
-
-impl Source {
-    /// Loads and validates the file as `sim run` does, and keeps its TOML document.
-    pub fn load(path: &Path) -> anyhow::Result<Source> {
-        let label = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("{label}: cannot read: {e}"))?;
-        let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
-        let stem = path
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("scenario");
-        let mut source = Source::from_text(&text, &label, &base_dir, stem)?;
-        source.path = path.to_path_buf();
-        Ok(source)
-    }
-
-    /// Scenario text from elsewhere (the attachment of a recording), called `label` in errors,
-    /// its relative paths resolved against `base_dir`, named `stem` unless it names itself.
-    pub fn from_text(
-        text: &str,
-        label: &str,
-        base_dir: &Path,
-        stem: &str,
-    ) -> anyhow::Result<Source> {
-        let plain = parse_scenario(text, label, base_dir, stem)?;
-        let doc: DocumentMut = text
-            .parse()
-            .map_err(|e| anyhow::anyhow!("{label}: not TOML: {e}"))?;
-        Ok(Source {
-            base_dir: base_dir.to_path_buf(),
-            stem: stem.to_string(),
-            path: PathBuf::from(label),
-            label: label.to_string(),
-            doc,
-            plain,
-        })
-    }
-
-    /// The scenario of one parameter set, or the error naming the override(s) at fault.
-    pub fn scenario(&self, overrides: &[Override]) -> Result<Scenario, String> {
-        if overrides.is_empty() {
-            return Ok(self.plain.clone());
-        }
-        let mut doc = self.doc.clone();
-        let mut applied = Vec::new();
-        for o in overrides {
-            let at = o.apply(&mut doc).map_err(|e| e.to_string())?;
-            applied.push((o.clone(), at));
-        }
-        parse_scenario(&doc.to_string(), &self.label, &self.base_dir, &self.stem).map_err(|e| {
-            let culprits = e.key.as_deref().map_or(Vec::new(), |k| blame(&applied, k));
-            let named: Vec<String> = if culprits.is_empty() {
-                overrides.iter().map(Override::describe).collect()
-            } else {
-                culprits.iter().map(|o| o.describe()).collect()
-            };
-            format!("{}: {e}", named.join(", "))
-        })
     }
 }
 

@@ -23,7 +23,7 @@ use systems::localization::{
     NavSource, OdometryModel, ScanEstimator, WheelOdometry,
 };
 use systems::mapping::{GraphSlam, MappingPlugin, RbpfSlam, ScanToMapSlam};
-use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
+use systems::navigation::{Behaviour, HeldCommand, NavCostmaps, NavigationPlugin, Navigator};
 use systems::raycast::{Door, Doors, StaticWorld};
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
@@ -243,6 +243,7 @@ fn spawn_robot(
         r.footprint.clone(),
         r.kinematics.clone(),
         DriveCommand::default(),
+        HeldCommand::default(),
         DriveState::default(),
         body,
         behaviour,

@@ -1,14 +1,15 @@
 //! Script set: timed scenario events fire at the first tick starting at or after their time:
-//! new waypoints, teleporting (kidnapping) a robot, sensor faults on and off, doors opening and
-//! closing. A door edits the static world (ray map, colliders, navigation costmaps follow its
+//! new waypoints, teleporting (kidnapping) a robot, sensor faults on and off, held velocity
+//! commands and their release, doors opening and closing. A door edits the static world (ray map, colliders, navigation costmaps follow its
 //! version) and the map the localizers believe in: the building tells its robots.
 
 use crate::scenario::{Event, EventAction, RobotConfig, SensorName};
 use bevy_ecs::prelude::*;
+use systems::body::DriveCommand;
 use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::{SimClock, SimPlugin, SimSet};
 use systems::localization::LocalizationMap;
-use systems::navigation::Behaviour;
+use systems::navigation::{Behaviour, HeldCommand};
 use systems::raycast::{Doors, StaticWorld};
 use systems::sensors::{Encoder, Laser, Sonars};
 
@@ -39,6 +40,16 @@ impl EventQueue {
             fired: Vec::new(),
         }
     }
+
+    /// Adds an event due at `now` (of the robot `entity`, or of the world): it fires at the
+    /// next tick, after the scenario's own events due then.
+    pub fn push_now(&mut self, event: Event, entity: Option<Entity>) {
+        let due = self.events[self.next..]
+            .iter()
+            .take_while(|(e, _)| e.at <= event.at + 1e-9)
+            .count();
+        self.events.insert(self.next + due, (event, entity));
+    }
 }
 
 /// The scenario's script: [`fire_events`] in the Script set (the world holds the [`EventQueue`]).
@@ -65,6 +76,7 @@ pub fn fire_events(
         Option<&mut Laser>,
         Option<&mut Encoder>,
         Option<&mut Sonars>,
+        Option<&mut HeldCommand>,
     )>,
 ) {
     let now = clock.start();
@@ -81,7 +93,7 @@ pub fn fire_events(
             queue.fired.push((now, String::new(), what));
             continue;
         }
-        let Some(Ok((behaviour, body, mut truth, laser, encoder, sonars))) =
+        let Some(Ok((behaviour, body, mut truth, laser, encoder, sonars, held))) =
             entity.map(|e| robots.get_mut(e))
         else {
             continue;
@@ -125,6 +137,16 @@ pub fn fire_events(
                     format!("{sensor:?}").to_lowercase(),
                     if *active { "on" } else { "off" }
                 )
+            }
+            EventAction::Drive { v, w } => {
+                let Some(mut held) = held else { continue };
+                held.0 = Some(DriveCommand { v: *v, w: *w });
+                format!("drive command held: v {v:.2} m/s, w {w:.2} rad/s")
+            }
+            EventAction::ReleaseDrive => {
+                let Some(mut held) = held else { continue };
+                held.0 = None;
+                "drive command released".to_string()
             }
             EventAction::Door { .. } => continue, // handled above
         };

@@ -4,10 +4,11 @@
 
 use super::args::ReplayArgs;
 use super::source::{RobotFeed, TimeBase, TopicFlags, first_stamp, robot_feed};
-use crate::batch::sets::{Source, plan_sets};
+use crate::batch::sets::plan_sets;
 use crate::record::mcap::McapRecording;
 use crate::record::topics::RunInfo;
 use crate::scenario::scenario_path;
+use crate::scenario::source::Source;
 use crate::scenario::{Scenario, assets_dir};
 use anyhow::{anyhow, bail};
 use std::path::{Path, PathBuf};

@@ -20,7 +20,7 @@ fn live(name: &str, duration: f64, mcap: &Path) -> RunOutput {
 
 /// [`live`] with `--set` overrides.
 fn live_with(name: &str, sets: &[&str], duration: f64, mcap: &Path) -> RunOutput {
-    let source = crate::batch::sets::Source::load(&scenario_file(name)).unwrap();
+    let source = crate::scenario::source::Source::load(&scenario_file(name)).unwrap();
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let plan = crate::batch::sets::plan_sets(&sets, &[], &[]).unwrap();
     let mut sc = source.scenario(&plan.sets[0]).unwrap();
@@ -334,7 +334,7 @@ fn the_set_example_of_the_help_applies_to_a_bundled_scenario() {
         .step_by(2)
         .find(|s| s.contains('='))
         .unwrap_or_else(|| panic!("no example in {help}"));
-    let source = crate::batch::sets::Source::load(&scenario_file("hospital_patrol")).unwrap();
+    let source = crate::scenario::source::Source::load(&scenario_file("hospital_patrol")).unwrap();
     let plan = crate::batch::sets::plan_sets(&[example.to_string()], &[], &[]).unwrap();
     let sc = source.scenario(&plan.sets[0]);
     assert!(sc.is_ok(), "{example}: {:?}", sc.err());

@@ -6,12 +6,15 @@
 //! the ticks run.
 
 pub mod capture;
+pub mod command;
 pub mod exports;
 pub mod interrupt;
 mod outputs;
 mod progress;
 pub mod report;
+pub mod simulation;
 pub mod summary;
+pub mod view;
 
 use crate::build::{SimWorld, build_world};
 use crate::formats::scans::ScanRecord;
@@ -21,15 +24,16 @@ use bevy_ecs::prelude::*;
 use capture::Capturer;
 use std::path::PathBuf;
 use std::time::Instant;
-use summary::{Summary, collect};
+use summary::Summary;
 use systems::body::TruePose;
 use systems::core::{Pose2, RobotIndex};
-use systems::navigation::Navigator;
-use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
 
 pub use crate::formats::tum::RobotLocalization;
 pub use capture::ScanCapture;
+pub use command::{Command, SimError};
 pub use outputs::output_plugins;
+pub use simulation::{Finished, Simulation, SimulationBuilder};
+pub use view::{Estimate, LocalizerView, NavigationView, RobotView, ScanView, Twist};
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
@@ -155,124 +159,80 @@ pub fn run_built(
     run_world(sim, scenario, opts, None, exports)
 }
 
-/// The phases of a run: the outputs join the schedule, the world steps to the end, the
-/// estimators and recordings are finished, the summary is read.
+/// The phases of a run, through the facade ([`Simulation`]): the outputs join the schedule, the
+/// world steps to the end (with a progress bar, the trajectory samples and the scan capture
+/// asked for), the estimators and recordings are finished, the summary is read.
 fn run_world(
-    mut sim: SimWorld,
+    sim: SimWorld,
     scenario: &Scenario,
     opts: &RunOptions,
     capture: Option<&ScanCapture>,
     exports: &RunExports,
 ) -> anyhow::Result<RunOutput> {
-    outputs::install(&mut sim, scenario, opts.rrd.as_deref(), exports)?;
+    let mut sim = Simulation::from_world(sim, scenario.clone(), opts.rrd.as_deref(), exports)?;
     let mut capturer = capture.map(Capturer::new);
-    let stepped = step_to_end(&mut sim, scenario, opts, capturer.as_mut());
-    let frame_error = outputs::finish_estimators_and_frames(&mut sim.world);
-    let wall_time_s = stepped.started.elapsed().as_secs_f64();
-    let exported = outputs::finish_files(&mut sim.world, scenario, exports)?;
+    let stepped = step_to_end(&mut sim, opts, capturer.as_mut());
     let mut trajectory = stepped.trajectory;
     if opts.trajectory_period.is_some() {
-        trajectory.push((sim.time(), truth_poses(&mut sim.world)));
+        trajectory.push((sim.time(), truth_poses(sim.world_mut())));
     }
-    if let Some(e) = frame_error {
-        anyhow::bail!("recording camera frames: {e}");
-    }
-    let sim_time_s = stepped.ticks as f64 * scenario.dt;
-    let summary = Summary {
-        scenario: scenario.name.clone(),
-        seed: scenario.seed,
-        sim_time_s,
-        wall_time_s,
-        real_time_factor: sim_time_s / wall_time_s.max(1e-9),
-        robots: collect::robot_summaries(&mut sim.world),
-    };
+    let done = sim.finish()?;
     Ok(RunOutput {
-        summary,
+        summary: done.summary,
         trajectory,
-        localization: collect::robot_localization(&mut sim.world),
+        localization: done.localization,
         scans: capturer.map(Capturer::into_scans).unwrap_or_default(),
-        log: collect::event_log(&mut sim.world),
-        exported,
+        log: done.log,
+        exported: done.exported,
         interrupted: stepped.interrupted,
     })
 }
 
 /// How the stepping ended.
 struct Stepped {
-    started: Instant,
-    /// Ticks run.
-    ticks: u64,
     /// Stopped by Ctrl-C or SIGTERM.
     interrupted: bool,
     /// True poses sampled at `RunOptions::trajectory_period`.
     trajectory: Vec<(f64, Vec<Pose2>)>,
 }
 
-/// Steps the world tick by tick until the scenario's duration, a stop asked for, or (when the
-/// scenario says so) every robot's tasks are done.
+/// Steps the world tick by tick until the scenario's end ([`Simulation::is_over`]) or a stop
+/// asked for.
 fn step_to_end(
-    sim: &mut SimWorld,
-    scenario: &Scenario,
+    sim: &mut Simulation,
     opts: &RunOptions,
     mut capturer: Option<&mut Capturer>,
 ) -> Stepped {
-    let ticks = (scenario.duration / scenario.dt).round().max(1.0) as u64;
-    let bar = progress::Progress::new(opts.progress, ticks, scenario.duration, scenario.dt);
+    let (duration, dt) = (sim.scenario().duration, sim.scenario().dt);
+    let bar = progress::Progress::new(opts.progress, sim.end_tick(), duration, dt);
     let started = Instant::now();
     let mut trajectory = Vec::new();
     let mut next_sample = 0.0;
-    let mut ticks_run = ticks;
     let mut interrupted = false;
-    for tick in 0..ticks {
+    while !sim.is_over() {
         if interrupt::requested() {
             interrupted = true;
-            ticks_run = tick;
             break;
         }
         if let Some(period) = opts.trajectory_period {
             let t = sim.time();
             if t + 1e-9 >= next_sample {
-                trajectory.push((t, truth_poses(&mut sim.world)));
+                trajectory.push((t, truth_poses(sim.world_mut())));
                 next_sample += period;
             }
         }
+        let tick = sim.ticks();
         sim.step();
         if let Some(c) = capturer.as_deref_mut() {
-            c.collect(&mut sim.world);
+            c.collect(sim.world_mut());
         }
         bar.tick(tick, started);
-        if scenario.end_when_done && tasks_all_done(&mut sim.world) {
-            ticks_run = tick + 1;
-            break;
-        }
     }
     bar.finish();
     Stepped {
-        started,
-        ticks: ticks_run,
         interrupted,
         trajectory,
     }
-}
-
-/// True when the scenario asks to end once every robot with tasks is done, and they are.
-fn tasks_all_done(w: &mut World) -> bool {
-    let mut q = w.query::<&Navigator>();
-    let mut any = false;
-    for n in q.iter(w) {
-        any = true;
-        if !n.finished() {
-            return false;
-        }
-    }
-    let mut q = w.query::<&RoadNavigator>();
-    for n in q.iter(w) {
-        any = true;
-        if n.phase != RoadPhase::Arrived {
-            return false;
-        }
-    }
-    any
 }
 
 fn truth_poses(w: &mut World) -> Vec<Pose2> {

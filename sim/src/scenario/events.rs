@@ -17,6 +17,8 @@ pub enum EventType {
     Teleport,
     SensorFault,
     Door,
+    Drive,
+    Release,
 }
 
 #[derive(Deserialize, Debug)]
@@ -41,6 +43,22 @@ pub struct EventFile {
     // door
     pub door: Option<String>,
     pub open: Option<bool>,
+    // drive: the held velocity command (m/s, rad/s)
+    pub v: Option<f64>,
+    pub w: Option<f64>,
+}
+
+impl EventFile {
+    /// The keys of waypoints, teleport and sensor_fault events, and whether each is given.
+    fn route_pose_and_sensor_keys(&self) -> [(&'static str, bool); 5] {
+        [
+            ("points", self.points.is_some()),
+            ("loop", self.looping.is_some()),
+            ("pose", self.pose.is_some()),
+            ("sensor", self.sensor.is_some()),
+            ("active", self.active.is_some()),
+        ]
+    }
 }
 
 /// Resolves a `points` key (a list of [x, y] or place names).
@@ -94,13 +112,8 @@ fn resolve_door_event(
             "a door event concerns no robot: remove `robot`",
         );
     }
-    for (key, present) in [
-        ("points", e.points.is_some()),
-        ("loop", e.looping.is_some()),
-        ("pose", e.pose.is_some()),
-        ("sensor", e.sensor.is_some()),
-        ("active", e.active.is_some()),
-    ] {
+    let speeds = [("v", e.v.is_some()), ("w", e.w.is_some())];
+    for (key, present) in e.route_pose_and_sensor_keys().into_iter().chain(speeds) {
         if present {
             return c.err(
                 &p.key(key),
@@ -147,6 +160,13 @@ fn resolve_robot_event(
         return c.err(
             &p.key(key),
             format!("`{key}` applies to `door` events only"),
+        );
+    }
+    if e.kind != EventType::Drive && (e.v.is_some() || e.w.is_some()) {
+        let key = if e.v.is_some() { "v" } else { "w" };
+        return c.err(
+            &p.key(key),
+            format!("`{key}` applies to `drive` events only"),
         );
     }
     let Some(robot_name) = &e.robot else {
@@ -226,6 +246,31 @@ fn resolve_robot_event(
             EventAction::SensorFault {
                 sensor,
                 active: e.active.unwrap_or(true),
+            }
+        }
+        EventType::Drive | EventType::Release => {
+            let kind = if e.kind == EventType::Drive {
+                "drive"
+            } else {
+                "release"
+            };
+            for (key, present) in e.route_pose_and_sensor_keys() {
+                only(key, present, kind)?;
+            }
+            if e.kind == EventType::Release {
+                EventAction::ReleaseDrive
+            } else {
+                let speed = |key: &str, v: Option<f64>| match v {
+                    Some(v) => c.range(&p.key(key), v, None, None, false),
+                    None => c.err(
+                        p,
+                        format!("a drive event needs `{key}` (`v` in m/s, `w` in rad/s)"),
+                    ),
+                };
+                EventAction::Drive {
+                    v: speed("v", e.v)?,
+                    w: speed("w", e.w)?,
+                }
             }
         }
     };

@@ -13,6 +13,7 @@ pub mod model;
 pub mod navigation;
 pub mod outdoor;
 pub mod outdoor_robot;
+pub mod overrides;
 pub mod people;
 pub mod places;
 pub mod resolve;
@@ -20,6 +21,7 @@ pub mod sensors;
 pub mod slam;
 pub mod slam_file;
 pub mod sonar;
+pub mod source;
 
 pub use error::ScenarioError;
 pub use load::{

@@ -126,6 +126,14 @@ pub enum EventAction {
         index: usize,
         open: bool,
     },
+    /// A velocity command (m/s, rad/s) held on the robot: it replaces what its behaviour or
+    /// navigator commands until released.
+    Drive {
+        v: f64,
+        w: f64,
+    },
+    /// The held command is dropped: the behaviour or navigator drives again.
+    ReleaseDrive,
 }
 
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]

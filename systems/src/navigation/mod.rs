@@ -20,6 +20,7 @@ pub mod costmap;
 pub mod drive;
 pub mod fleet;
 pub mod follower;
+pub mod held;
 pub mod local_map;
 pub mod navigator;
 pub mod open_list;
@@ -37,6 +38,7 @@ pub use behaviour::{Behaviour, BehaviourKind, NavStatus};
 pub use costmap::{Costmap, CostmapParams};
 pub use fleet::Fleet;
 pub use follower::{FollowerParams, Steering};
+pub use held::HeldCommand;
 pub use navigator::{NavParams, Navigator, Phase};
 pub use outcomes::{LegEvent, NavEvent, NavFailure, NavMetrics};
 pub use road_follow::{Keep, RoadCommand, RoadFollowParams, road_steering};
@@ -73,6 +75,8 @@ impl SimPlugin for NavigationPlugin {
                 behaviour::drive_behaviours,
                 drive::drive_navigators.before(road_drive::system::drive_road_navigators),
                 road_drive::system::drive_road_navigators.before(behaviour::drive_behaviours),
+                // a held command replaces theirs
+                held::apply_held_commands.after(behaviour::drive_behaviours),
             )
                 .in_set(SimSet::Control),
         );

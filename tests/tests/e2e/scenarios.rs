@@ -139,6 +139,26 @@ fn semantic_errors() {
         with_robot("")
     ));
     assert!(e.contains("no encoder sensor"), "{e}");
+    // held velocity commands
+    let event = |body: &str| {
+        format!(
+            "{}\n[[events]]\nat = 0.5\nrobot = \"r1\"\n{body}",
+            with_robot("")
+        )
+    };
+    let e = scenario_error(&event("type = \"drive\"\nv = 0.3\n"));
+    assert!(e.contains("a drive event needs `w`"), "{e}");
+    let e = scenario_error(&event("type = \"drive\"\nv = nan\nw = 0.0\n"));
+    assert!(e.contains("events[0].v") && e.contains("finite"), "{e}");
+    let e = scenario_error(&event(
+        "type = \"teleport\"\npose = [1.0, 1.0, 0.0]\nv = 0.3\n",
+    ));
+    assert!(e.contains("`v` applies to `drive` events only"), "{e}");
+    let e = scenario_error(&event("type = \"release\"\npose = [1.0, 1.0, 0.0]\n"));
+    assert!(
+        e.contains("`pose` does not apply to a `release` event"),
+        "{e}"
+    );
     // no world
     let e = scenario_error("duration = 3.0\n");
     assert!(e.contains("world is empty"), "{e}");

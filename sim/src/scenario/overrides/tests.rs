@@ -113,12 +113,18 @@ fn structural_errors() {
         ("robots.speed", "`robots` is an array: select an item"),
         ("duration.x", "`duration` is a number, not a table"),
         ("robots.0", "is a whole table"),
-        ("seed", "comes from --seeds"),
     ] {
         let e = set(k, "1").unwrap_err().to_string();
         assert!(e.starts_with(&format!("--set {k}=1: ")), "{e}");
         assert!(e.contains(want), "{k}: {e}");
     }
+}
+
+#[test]
+fn the_top_level_seed_is_told_apart() {
+    let o = |k: &str| Override::new("--set", k, "1").unwrap();
+    assert!(o("seed").is_seed());
+    assert!(!o("robots.0.seed").is_seed() && !o("duration").is_seed());
 }
 
 #[test]

@@ -95,9 +95,6 @@ pub fn parse_value(text: &str) -> Value {
 impl Override {
     pub fn new(flag: &'static str, key: &str, text: &str) -> anyhow::Result<Override> {
         let path = parse_path(flag, key)?;
-        if matches!(path.as_slice(), [Step::Key(k)] if k == "seed") {
-            anyhow::bail!("{flag} {key}={text}: the seed of each run comes from --seeds");
-        }
         Ok(Override {
             flag,
             key: key.to_string(),
@@ -105,6 +102,11 @@ impl Override {
             text: text.to_string(),
             value: parse_value(text),
         })
+    }
+
+    /// Whether it sets the scenario's top-level `seed`.
+    pub fn is_seed(&self) -> bool {
+        matches!(self.path.as_slice(), [Step::Key(k)] if k == "seed")
     }
 
     /// How it was given: `--sweep key=value`.

@@ -1,0 +1,98 @@
+//! Commands a program gives a [`super::Simulation`] between ticks, and the errors of the
+//! facade. A command becomes a scenario event due now: it takes effect at the next tick, in the
+//! Script set, exactly as the same event written in the scenario file would.
+
+use crate::scenario::{EventAction, SensorName};
+use systems::core::Pose2;
+
+/// What a robot is told to do.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// A new route for a robot driven by a behaviour (followed once, or round and round).
+    Waypoints {
+        points: Vec<[f64; 2]>,
+        looping: bool,
+    },
+    /// Moves the robot to `pose` without telling its estimators (a kidnapping).
+    Teleport(Pose2),
+    /// A sensor stops (`active`) or resumes producing readings.
+    SensorFault { sensor: SensorName, active: bool },
+    /// A velocity command (forward m/s, yaw rate rad/s; an Ackermann robot steers to that yaw
+    /// rate) held until replaced or released; the robot's limits still apply.
+    Drive { v: f64, w: f64 },
+    /// Drops the held velocity command: the behaviour or navigator drives again.
+    Release,
+}
+
+/// Why the facade refused a request.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SimError {
+    #[error("no robot named `{name}` (robots: {known})")]
+    UnknownRobot { name: String, known: String },
+    #[error("no door named `{name}` (doors: {known})")]
+    UnknownDoor { name: String, known: String },
+    #[error("robot `{robot}` has no {sensor}")]
+    NoSuchSensor { robot: String, sensor: String },
+    #[error("robot `{robot}` follows navigation tasks, not waypoints")]
+    NotOnWaypoints { robot: String },
+    #[error("{what}: expected {expected}, got {got}")]
+    BadValue {
+        what: String,
+        expected: &'static str,
+        got: String,
+    },
+    #[error("{what} ({x}, {y}) would place the robot inside an obstacle")]
+    InsideObstacle { what: String, x: f64, y: f64 },
+    #[error("{what} ({x}, {y}) is outside the map ({bounds})")]
+    OutsideMap {
+        what: String,
+        x: f64,
+        y: f64,
+        bounds: String,
+    },
+}
+
+impl Command {
+    /// The scenario event action of the command, after checking its numbers (`robot` names it
+    /// in errors).
+    pub(super) fn action(self, robot: &str) -> Result<EventAction, SimError> {
+        let finite = |what: String, v: &[f64]| {
+            if v.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(SimError::BadValue {
+                    what,
+                    expected: "finite numbers",
+                    got: format!("{v:?}"),
+                })
+            }
+        };
+        match self {
+            Command::Waypoints { points, looping } => {
+                if points.is_empty() {
+                    return Err(SimError::BadValue {
+                        what: format!("waypoints of `{robot}`"),
+                        expected: "at least one point",
+                        got: "none".into(),
+                    });
+                }
+                for (i, p) in points.iter().enumerate() {
+                    finite(format!("waypoint {i} of `{robot}`"), p)?;
+                }
+                Ok(EventAction::Waypoints { points, looping })
+            }
+            Command::Teleport(p) => {
+                finite(format!("teleport pose of `{robot}`"), &[p.x, p.y, p.theta])?;
+                Ok(EventAction::Teleport(p))
+            }
+            Command::SensorFault { sensor, active } => {
+                Ok(EventAction::SensorFault { sensor, active })
+            }
+            Command::Drive { v, w } => {
+                finite(format!("drive command of `{robot}`"), &[v, w])?;
+                Ok(EventAction::Drive { v, w })
+            }
+            Command::Release => Ok(EventAction::ReleaseDrive),
+        }
+    }
+}

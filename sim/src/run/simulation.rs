@@ -1,0 +1,532 @@
+//! [`Simulation`]: a scenario's world that a program loads, steps, reads and commands between
+//! ticks: the simulator as a library. `sim run`, `sim batch` and `sim replay` drive this same
+//! type ([`super::run_world`]), so a program gets their schedule, determinism, recordings and
+//! summary.
+//!
+//! ```no_run
+//! use sim::Simulation;
+//!
+//! let mut s = Simulation::load("hospital_patrol").seed(4).duration(30.0).build()?;
+//! s.run_for(5.0)?;
+//! let r1 = s.robot("r1")?;
+//! println!("r1 at {:?}, odometry {:?}", r1.pose(), r1.odometry());
+//! let done = s.run()?;
+//! println!("{} robots, {:.1} s", done.summary.robots.len(), done.summary.sim_time_s);
+//! # anyhow::Ok(())
+//! ```
+
+use super::command::{Command, SimError};
+use super::exports::{Exported, RunExports};
+use super::outputs;
+use super::summary::{Summary, collect};
+use super::view::{DoorView, RobotView};
+use crate::build::script::EventQueue;
+use crate::build::{SimWorld, build_world};
+use crate::formats::tum::RobotLocalization;
+use crate::options::check_duration;
+use crate::scenario::overrides::Override;
+use crate::scenario::source::Source;
+use crate::scenario::{Event, EventAction, Scenario, load_scenario, scenario_path};
+use bevy_ecs::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use systems::navigation::Navigator;
+use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
+use systems::raycast::Doors;
+
+/// A running simulation of one scenario.
+pub struct Simulation {
+    sim: SimWorld,
+    scenario: Scenario,
+    exports: RunExports,
+    /// Ticks run so far.
+    ticks: u64,
+    /// When the first tick started (the summary's wall time counts from there).
+    started: Option<Instant>,
+}
+
+/// What a finished simulation leaves: its summary (what `--summary` writes), every robot's
+/// estimates beside the truth, the event log and the files exported.
+pub struct Finished {
+    pub summary: Summary,
+    pub localization: Vec<RobotLocalization>,
+    /// Scenario and navigation events in time order: (time, robot or "" for the world, text).
+    pub log: Vec<(f64, String, String)>,
+    pub exported: Exported,
+}
+
+enum Input {
+    /// A bundled scenario's name or a file.
+    Named(String),
+    /// Scenario TOML, with the label errors name it by and the folder its relative paths
+    /// start from.
+    Toml {
+        text: String,
+        label: String,
+        base_dir: PathBuf,
+    },
+    /// A scenario made in code.
+    Built(Box<Scenario>),
+}
+
+/// How to make a [`Simulation`]: the scenario, its overrides and the outputs to write.
+pub struct SimulationBuilder {
+    input: Input,
+    sets: Vec<(String, String)>,
+    seed: Option<u64>,
+    duration: Option<f64>,
+    threads: usize,
+    rrd: Option<PathBuf>,
+    exports: RunExports,
+}
+
+impl SimulationBuilder {
+    fn new(input: Input) -> Self {
+        SimulationBuilder {
+            input,
+            sets: Vec::new(),
+            seed: None,
+            duration: None,
+            threads: 0,
+            rrd: None,
+            exports: RunExports::default(),
+        }
+    }
+
+    /// The folder relative paths of scenario TOML text ([`Simulation::from_toml`]) start from.
+    pub fn relative_to(mut self, dir: impl Into<PathBuf>) -> Self {
+        if let Input::Toml { base_dir, .. } = &mut self.input {
+            *base_dir = dir.into();
+        }
+        self
+    }
+
+    /// The scenario's seed instead of the file's.
+    pub fn seed(mut self, seed: u64) -> Self {
+        self.seed = Some(seed);
+        self
+    }
+
+    /// The scenario's duration (simulated seconds) instead of the file's.
+    pub fn duration(mut self, seconds: f64) -> Self {
+        self.duration = Some(seconds);
+        self
+    }
+
+    /// Overrides a key of the scenario file, as `sim batch --set KEY=VALUE` does
+    /// (`robots[name=r1].sensors.laser.rate`, `"20"`); the value is TOML (a bare word is a
+    /// string). Not for scenarios built in code: change their fields.
+    pub fn set(mut self, key: &str, value: &str) -> Self {
+        self.sets.push((key.to_string(), value.to_string()));
+        self
+    }
+
+    /// Worker threads of the parallel kernels (0, the default: one per core). Results do not
+    /// depend on it.
+    pub fn threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
+        self
+    }
+
+    /// Writes a Rerun recording, as `sim run --rrd` does.
+    pub fn rrd(mut self, path: impl Into<PathBuf>) -> Self {
+        self.rrd = Some(path.into());
+        self
+    }
+
+    /// Writes an MCAP replay, as `sim run --mcap` does.
+    pub fn mcap(mut self, path: impl Into<PathBuf>) -> Self {
+        self.exports.mcap = Some(path.into());
+        self
+    }
+
+    /// Writes CARMEN logs, as `sim run --carmen-out` does.
+    pub fn carmen(mut self, path: impl Into<PathBuf>) -> Self {
+        self.exports.carmen_out = Some(path.into());
+        self
+    }
+
+    /// Saves the maps at the end, as `sim run --save-map` does.
+    pub fn save_map(mut self, path: impl Into<PathBuf>) -> Self {
+        self.exports.save_map = Some(path.into());
+        self
+    }
+
+    /// The scenario with every override applied and validated.
+    pub fn scenario(&self) -> anyhow::Result<Scenario> {
+        let overrides = self
+            .sets
+            .iter()
+            .map(|(k, v)| Override::new("set", k, v))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let mut sc = match &self.input {
+            Input::Named(name) if overrides.is_empty() => {
+                load_scenario(&scenario_path(Some(name))?)?
+            }
+            Input::Named(name) => Source::load(&scenario_path(Some(name))?)?
+                .scenario(&overrides)
+                .map_err(anyhow::Error::msg)?,
+            Input::Toml {
+                text,
+                label,
+                base_dir,
+            } => Source::from_text(text, label, base_dir, "scenario")?
+                .scenario(&overrides)
+                .map_err(anyhow::Error::msg)?,
+            Input::Built(sc) if overrides.is_empty() => (**sc).clone(),
+            Input::Built(_) => anyhow::bail!(
+                "set {}: a scenario built in code has no file to override; change its fields",
+                self.sets[0].0
+            ),
+        };
+        if let Some(s) = self.seed {
+            sc.seed = s;
+        }
+        if let Some(d) = self.duration {
+            sc.duration = check_duration(d)?;
+        }
+        Ok(sc)
+    }
+
+    /// Builds the world, opens the outputs' files and adds their recorders to the schedule.
+    pub fn build(self) -> anyhow::Result<Simulation> {
+        let scenario = self.scenario()?;
+        let world = build_world(&scenario, self.threads)?;
+        Simulation::from_world(world, scenario, self.rrd.as_deref(), &self.exports)
+    }
+}
+
+impl Simulation {
+    /// A bundled scenario by name (`hospital_patrol`), or a scenario file.
+    pub fn load(name_or_file: &str) -> SimulationBuilder {
+        SimulationBuilder::new(Input::Named(name_or_file.to_string()))
+    }
+
+    /// Scenario TOML text, called `label` in error messages; relative paths in it (maps, places)
+    /// resolve against the current folder, or the one given to
+    /// [`SimulationBuilder::relative_to`].
+    pub fn from_toml(text: &str, label: &str) -> SimulationBuilder {
+        SimulationBuilder::new(Input::Toml {
+            text: text.to_string(),
+            label: label.to_string(),
+            base_dir: PathBuf::from("."),
+        })
+    }
+
+    /// A scenario made in code.
+    pub fn from_scenario(scenario: Scenario) -> SimulationBuilder {
+        SimulationBuilder::new(Input::Built(Box::new(scenario)))
+    }
+
+    /// A world built from `scenario` (a run's, or a replay's) with the outputs asked for.
+    pub(crate) fn from_world(
+        mut sim: SimWorld,
+        scenario: Scenario,
+        rrd: Option<&Path>,
+        exports: &RunExports,
+    ) -> anyhow::Result<Simulation> {
+        outputs::install(&mut sim, &scenario, rrd, exports)?;
+        Ok(Simulation {
+            sim,
+            scenario,
+            exports: exports.clone(),
+            ticks: 0,
+            started: None,
+        })
+    }
+
+    /// The scenario being run.
+    pub fn scenario(&self) -> &Scenario {
+        &self.scenario
+    }
+
+    /// Simulated time (s): the start of the next tick.
+    pub fn time(&self) -> f64 {
+        self.sim.time()
+    }
+
+    /// Ticks run so far.
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+
+    /// The ticks of the scenario's duration.
+    pub fn end_tick(&self) -> u64 {
+        (self.scenario.duration / self.scenario.dt).round().max(1.0) as u64
+    }
+
+    /// One tick of the schedule.
+    pub fn step(&mut self) {
+        self.started.get_or_insert_with(Instant::now);
+        self.sim.step();
+        self.ticks += 1;
+    }
+
+    /// The scenario's duration is over, or it ends when every task is done and they are.
+    pub fn is_over(&mut self) -> bool {
+        // a run has at least one tick
+        self.ticks >= self.end_tick()
+            || (self.ticks > 0
+                && self.scenario.end_when_done
+                && tasks_all_done(&mut self.sim.world))
+    }
+
+    /// Steps `seconds` of simulated time (rounded to whole ticks), even past the scenario's
+    /// duration.
+    pub fn run_for(&mut self, seconds: f64) -> Result<(), SimError> {
+        for _ in 0..self.ticks_in(seconds)? {
+            self.step();
+        }
+        Ok(())
+    }
+
+    /// Steps until `done` holds (checked before every tick) or `max_seconds` have passed;
+    /// whether `done` held.
+    pub fn run_until(
+        &mut self,
+        mut done: impl FnMut(&Simulation) -> bool,
+        max_seconds: f64,
+    ) -> Result<bool, SimError> {
+        for _ in 0..self.ticks_in(max_seconds)? {
+            if done(self) {
+                return Ok(true);
+            }
+            self.step();
+        }
+        Ok(done(self))
+    }
+
+    fn ticks_in(&self, seconds: f64) -> Result<u64, SimError> {
+        if !(seconds.is_finite() && seconds >= 0.0) {
+            return Err(SimError::BadValue {
+                what: "simulated time".into(),
+                expected: "a finite number of seconds >= 0",
+                got: seconds.to_string(),
+            });
+        }
+        Ok((seconds / self.scenario.dt).round() as u64)
+    }
+
+    /// Steps to the scenario's end, then [`Simulation::finish`].
+    pub fn run(mut self) -> anyhow::Result<Finished> {
+        while !self.is_over() {
+            self.step();
+        }
+        self.finish()
+    }
+
+    /// Ends the run where it is: the estimators and recordings are finished, the files
+    /// written, and the summary read (covering the ticks run).
+    pub fn finish(mut self) -> anyhow::Result<Finished> {
+        let world = &mut self.sim.world;
+        let frame_error = outputs::finish_estimators_and_frames(world);
+        let wall_time_s = self.started.map_or(0.0, |s| s.elapsed().as_secs_f64());
+        let exported = outputs::finish_files(world, &self.scenario, &self.exports)?;
+        if let Some(e) = frame_error {
+            anyhow::bail!("recording camera frames: {e}");
+        }
+        let sim_time_s = self.ticks as f64 * self.scenario.dt;
+        let summary = Summary {
+            scenario: self.scenario.name.clone(),
+            seed: self.scenario.seed,
+            sim_time_s,
+            wall_time_s,
+            real_time_factor: sim_time_s / wall_time_s.max(1e-9),
+            robots: collect::robot_summaries(world),
+        };
+        Ok(Finished {
+            summary,
+            localization: collect::robot_localization(world),
+            log: collect::event_log(world),
+            exported,
+        })
+    }
+
+    /// The robot called `name`.
+    pub fn robot(&self, name: &str) -> Result<RobotView<'_>, SimError> {
+        let index = self.robot_index(name)?;
+        Ok(self.view(index))
+    }
+
+    /// Every robot, in the scenario's order.
+    pub fn robots(&self) -> Vec<RobotView<'_>> {
+        (0..self.sim.robots.len()).map(|i| self.view(i)).collect()
+    }
+
+    fn view(&self, index: usize) -> RobotView<'_> {
+        RobotView {
+            world: &self.sim.world,
+            entity: self.sim.robots[index],
+            name: &self.scenario.robots[index].name,
+            index,
+        }
+    }
+
+    fn robot_index(&self, name: &str) -> Result<usize, SimError> {
+        self.scenario
+            .robots
+            .iter()
+            .position(|r| r.name == name)
+            .ok_or_else(|| SimError::UnknownRobot {
+                name: name.to_string(),
+                known: names(self.scenario.robots.iter().map(|r| r.name.as_str())),
+            })
+    }
+
+    /// The world's doors and whether each is open.
+    pub fn doors(&self) -> Vec<DoorView> {
+        self.sim
+            .world
+            .get_resource::<Doors>()
+            .map_or(Vec::new(), |d| {
+                d.doors
+                    .iter()
+                    .map(|d| DoorView {
+                        name: d.name.clone(),
+                        open: d.open,
+                    })
+                    .collect()
+            })
+    }
+
+    /// Tells robot `robot` what to do; it takes effect at the next tick, as the same event in
+    /// the scenario file would.
+    pub fn command(&mut self, robot: &str, command: Command) -> Result<(), SimError> {
+        let index = self.robot_index(robot)?;
+        let config = &self.scenario.robots[index];
+        match &command {
+            Command::Waypoints { .. } if config.navigation.is_some() => {
+                return Err(SimError::NotOnWaypoints {
+                    robot: robot.to_string(),
+                });
+            }
+            Command::SensorFault { sensor, .. } => {
+                let has = match sensor {
+                    crate::scenario::SensorName::Laser => config.laser.is_some(),
+                    crate::scenario::SensorName::Encoder => config.encoder.is_some(),
+                    crate::scenario::SensorName::Sonar => config.sonar.is_some(),
+                };
+                if !has {
+                    return Err(SimError::NoSuchSensor {
+                        robot: robot.to_string(),
+                        sensor: format!("{sensor:?}").to_lowercase(),
+                    });
+                }
+            }
+            _ => {}
+        }
+        let action = command.action(robot)?;
+        match &action {
+            EventAction::Teleport(p) => {
+                let what = format!("teleport pose of `{robot}`");
+                self.check_inside(&what, p.x, p.y)?;
+                let radius = config.footprint.bounding_radius();
+                if !self.scenario.grid.disc_is_clear(p.x, p.y, radius) {
+                    return Err(SimError::InsideObstacle {
+                        what,
+                        x: p.x,
+                        y: p.y,
+                    });
+                }
+            }
+            EventAction::Waypoints { points, .. } => {
+                for (i, p) in points.iter().enumerate() {
+                    self.check_inside(&format!("waypoint {i} of `{robot}`"), p[0], p[1])?;
+                }
+            }
+            _ => {}
+        }
+        let entity = self.sim.robots[index];
+        self.push(Some(robot.to_string()), Some(entity), action);
+        Ok(())
+    }
+
+    /// Opens or closes the door called `door` at the next tick, as the same event in the
+    /// scenario file would.
+    pub fn set_door(&mut self, door: &str, open: bool) -> Result<(), SimError> {
+        let doors = &self.scenario.doors;
+        let index =
+            doors
+                .iter()
+                .position(|d| d.name == door)
+                .ok_or_else(|| SimError::UnknownDoor {
+                    name: door.to_string(),
+                    known: names(doors.iter().map(|d| d.name.as_str())),
+                })?;
+        self.push(None, None, EventAction::Door { index, open });
+        Ok(())
+    }
+
+    fn push(&mut self, robot: Option<String>, entity: Option<Entity>, action: EventAction) {
+        let event = Event {
+            at: self.time(),
+            robot,
+            action,
+        };
+        self.sim
+            .world
+            .resource_mut::<EventQueue>()
+            .push_now(event, entity);
+    }
+
+    fn check_inside(&self, what: &str, x: f64, y: f64) -> Result<(), SimError> {
+        let [x0, y0, x1, y1] = self.scenario.grid.bounds();
+        if (x0..=x1).contains(&x) && (y0..=y1).contains(&y) {
+            return Ok(());
+        }
+        Err(SimError::OutsideMap {
+            what: what.to_string(),
+            x,
+            y,
+            bounds: format!("x {x0} to {x1}, y {y0} to {y1}"),
+        })
+    }
+
+    /// The ECS world, for programs that read what no view offers.
+    pub fn world(&self) -> &World {
+        &self.sim.world
+    }
+
+    /// The ECS world and the tick's schedule, for programs that add their own components,
+    /// resources or systems (in a [`systems::core::SimSet`]) before the first tick.
+    pub fn world_and_schedule(&mut self) -> (&mut World, &mut Schedule) {
+        (&mut self.sim.world, &mut self.sim.schedule)
+    }
+
+    /// The ECS world.
+    pub fn world_mut(&mut self) -> &mut World {
+        &mut self.sim.world
+    }
+}
+
+fn names<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let v: Vec<&str> = names.collect();
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
+}
+
+/// True when some robot has tasks and every such robot is done with them.
+fn tasks_all_done(w: &mut World) -> bool {
+    let mut q = w.query::<&Navigator>();
+    let mut any = false;
+    for n in q.iter(w) {
+        any = true;
+        if !n.finished() {
+            return false;
+        }
+    }
+    let mut q = w.query::<&RoadNavigator>();
+    for n in q.iter(w) {
+        any = true;
+        if n.phase != RoadPhase::Arrived {
+            return false;
+        }
+    }
+    any
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,253 @@
+//! Typed, read-only views of a [`super::Simulation`]'s robots, people and doors between ticks:
+//! what a script or a user's program reads instead of querying the ECS world. A view borrows
+//! the world; it is taken again after each step.
+
+use bevy_ecs::prelude::*;
+use systems::body::{Collisions, TruePose, TrueTwist};
+use systems::core::Pose2;
+use systems::eval::RobotMetrics;
+use systems::localization::{Localizers, WheelOdometry};
+use systems::navigation::Navigator;
+use systems::navigation::navigator::Phase;
+use systems::sensors::camera::CameraFrame;
+use systems::sensors::{
+    CameraImages, CompassReading, CompassReadings, EncoderReading, EncoderReadings, GpsFix,
+    GpsReadings, LaserScan, LaserScans, LaserTruth, SonarReadings,
+};
+
+/// A robot's linear and angular velocity (m/s, rad/s).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Twist {
+    pub v: f64,
+    pub w: f64,
+}
+
+/// One robot of a running simulation.
+#[derive(Clone, Copy)]
+pub struct RobotView<'w> {
+    pub(super) world: &'w World,
+    pub(super) entity: Entity,
+    pub(super) name: &'w str,
+    pub(super) index: usize,
+}
+
+impl<'w> RobotView<'w> {
+    /// The robot's name in the scenario.
+    pub fn name(&self) -> &'w str {
+        self.name
+    }
+
+    /// Its place in the scenario's robot list.
+    pub fn index(&self) -> usize {
+        self.index
+    }
+
+    /// The ECS entity, for programs that add their own components or systems.
+    pub fn entity(&self) -> Entity {
+        self.entity
+    }
+
+    fn get<T: Component>(&self) -> Option<&'w T> {
+        self.world.get::<T>(self.entity)
+    }
+
+    /// The true pose (ground truth, world frame).
+    pub fn pose(&self) -> Pose2 {
+        self.get::<TruePose>().map(|t| t.pose).unwrap_or_default()
+    }
+
+    /// The true velocity.
+    pub fn twist(&self) -> Twist {
+        self.get::<TrueTwist>()
+            .map(|t| Twist { v: t.v, w: t.w })
+            .unwrap_or_default()
+    }
+
+    /// The pose integrated from the wheel encoders (None without encoders).
+    pub fn odometry(&self) -> Option<Pose2> {
+        self.get::<WheelOdometry>().map(|o| o.pose)
+    }
+
+    /// The latest laser scan, of this tick or an earlier one (None before the first scan or
+    /// without a laser).
+    pub fn scan(&self) -> Option<ScanView<'w>> {
+        let scan = self.get::<LaserScans>()?.latest()?;
+        let sensor = self.get::<LaserTruth>().and_then(|t| t.latest);
+        Some(ScanView { scan, sensor })
+    }
+
+    /// The encoder readings of the last tick.
+    pub fn encoder_readings(&self) -> &'w [EncoderReading] {
+        self.get::<EncoderReadings>()
+            .map_or(&[], |r| r.readings.as_slice())
+    }
+
+    /// The GPS fixes of the last tick.
+    pub fn gps_fixes(&self) -> &'w [GpsFix] {
+        self.get::<GpsReadings>()
+            .map_or(&[], |r| r.fixes.as_slice())
+    }
+
+    /// The compass readings of the last tick.
+    pub fn compass_readings(&self) -> &'w [CompassReading] {
+        self.get::<CompassReadings>()
+            .map_or(&[], |r| r.readings.as_slice())
+    }
+
+    /// The latest sonar ranges, one per mount (None without sonars).
+    pub fn sonar(&self) -> Option<&'w SonarReadings> {
+        self.get::<SonarReadings>()
+    }
+
+    /// The latest camera frame (None without a camera, or before its first frame).
+    pub fn camera(&self) -> Option<&'w CameraFrame> {
+        self.get::<CameraImages>()?.frame.as_ref()
+    }
+
+    /// Every localizer and SLAM system of the robot, in the scenario's order.
+    pub fn localizers(&self) -> Vec<LocalizerView<'w>> {
+        self.get::<Localizers>().map_or(Vec::new(), |l| {
+            l.items
+                .iter()
+                .map(|l| LocalizerView {
+                    name: &l.name,
+                    kind: l.filter.kind(),
+                    estimate: l.latest.as_ref().map(|e| Estimate {
+                        stamp: e.stamp,
+                        pose: e.estimate.pose,
+                        covariance: e.estimate.covariance,
+                    }),
+                })
+                .collect()
+        })
+    }
+
+    /// The localizer or SLAM system called `name`.
+    pub fn localizer(&self, name: &str) -> Option<LocalizerView<'w>> {
+        self.localizers().into_iter().find(|l| l.name == name)
+    }
+
+    /// The navigator's tasks and state (None for a robot driven by a behaviour).
+    pub fn navigation(&self) -> Option<NavigationView<'w>> {
+        self.get::<Navigator>()
+            .map(|n| NavigationView { navigator: n })
+    }
+
+    /// Collisions so far, with walls, other robots and people.
+    pub fn collisions(&self) -> Collisions {
+        self.get::<RobotMetrics>()
+            .map(|m| m.collisions)
+            .unwrap_or_default()
+    }
+
+    /// Distance driven so far (m).
+    pub fn distance(&self) -> f64 {
+        self.get::<RobotMetrics>().map_or(0.0, |m| m.distance_m)
+    }
+}
+
+/// A laser scan and the true sensor pose it was taken from.
+#[derive(Clone, Copy)]
+pub struct ScanView<'w> {
+    scan: &'w LaserScan,
+    sensor: Option<Pose2>,
+}
+
+impl<'w> ScanView<'w> {
+    /// The scan as the sensor reported it (stamp, angles, ranges; +Inf for no return).
+    pub fn scan(&self) -> &'w LaserScan {
+        self.scan
+    }
+
+    pub fn ranges(&self) -> &'w [f32] {
+        &self.scan.ranges
+    }
+
+    /// The beam angles in the sensor frame (rad), one per range.
+    pub fn angles(&self) -> impl Iterator<Item = f32> + 'w {
+        let s = self.scan;
+        (0..s.ranges.len()).map(move |i| s.angle_min + i as f32 * s.angle_increment)
+    }
+
+    /// The true sensor pose of the scan (world frame).
+    pub fn sensor_pose(&self) -> Option<Pose2> {
+        self.sensor
+    }
+
+    /// The returns as points in the world frame, from the true sensor pose (beams without a
+    /// return, or below the minimum range, left out).
+    pub fn world_points(&self) -> Vec<[f64; 2]> {
+        let Some(p) = self.sensor else {
+            return Vec::new();
+        };
+        let (min, max) = (self.scan.range_min, self.scan.range_max);
+        self.angles()
+            .zip(&self.scan.ranges)
+            .filter(|(_, r)| r.is_finite() && **r >= min && **r <= max)
+            .map(|(a, &r)| {
+                let t = p.theta + a as f64;
+                [p.x + r as f64 * t.cos(), p.y + r as f64 * t.sin()]
+            })
+            .collect()
+    }
+}
+
+/// A pose estimate with its covariance (x, y, θ).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// The time of the data it comes from (s).
+    pub stamp: f64,
+    pub pose: Pose2,
+    pub covariance: [[f64; 3]; 3],
+}
+
+/// One localizer or SLAM system of a robot.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalizerView<'w> {
+    /// The name given in the scenario.
+    pub name: &'w str,
+    /// Its type as written in scenario files (`mcl`, `markov_grid`, ...).
+    pub kind: &'static str,
+    /// The latest estimate (None before its first).
+    pub estimate: Option<Estimate>,
+}
+
+/// A robot's navigator.
+#[derive(Clone, Copy)]
+pub struct NavigationView<'w> {
+    navigator: &'w Navigator,
+}
+
+impl<'w> NavigationView<'w> {
+    /// Tasks done so far.
+    pub fn tasks_done(&self) -> usize {
+        self.navigator.task.min(self.navigator.tasks.len())
+    }
+
+    /// Tasks given in all.
+    pub fn tasks(&self) -> usize {
+        self.navigator.tasks.len()
+    }
+
+    /// Every task is done and the robot is idle.
+    pub fn finished(&self) -> bool {
+        self.navigator.finished()
+    }
+
+    /// What it is doing now.
+    pub fn phase(&self) -> &'w Phase {
+        &self.navigator.phase
+    }
+
+    /// The current task, as the recording describes it.
+    pub fn status(&self) -> String {
+        self.navigator.status_text()
+    }
+}
+
+/// A door of the world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DoorView {
+    pub name: String,
+    pub open: bool,
+}
