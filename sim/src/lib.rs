@@ -19,7 +19,8 @@
 //! # anyhow::Ok(())
 //! ```
 //!
-//! Next: the guide (sim/docs/scripting.md), [`run::RobotView`] for what can be read,
+//! `use sim::prelude::*;` brings these names and the `systems` prelude. Next: the guide
+//! (sim/docs/scripting.md), [`run::RobotView`] for what can be read,
 //! [`Command`] for what can be told, and the `systems` crate for the components and systems
 //! themselves.
 
@@ -31,6 +32,7 @@ pub mod experiment;
 pub mod formats;
 pub mod log_slam;
 pub mod options;
+pub mod prelude;
 pub mod record;
 pub mod replay;
 pub mod run;

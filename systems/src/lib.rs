@@ -13,6 +13,7 @@ pub mod localization;
 pub mod mapping;
 pub mod matching;
 pub mod navigation;
+pub mod prelude;
 pub mod raycast;
 pub mod sensors;
 pub mod world;

@@ -16,6 +16,8 @@ const SYSTEMS_LEVELS: &[&[&str]] = &[
     &["matching"],
     &["localization"],
     &["mapping", "navigation", "eval"],
+    // re-exports from every level
+    &["prelude"],
 ];
 
 fn src(krate: &str) -> PathBuf {
