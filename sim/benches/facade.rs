@@ -26,8 +26,8 @@ fn one_robot(c: &mut Criterion) {
             .unwrap();
         let (v, w) = (0.0, 0.0);
         facade.command("r0000", Command::Drive { v, w }).unwrap();
-        facade.step();
-        g.bench_function("facade", |b| b.iter(|| facade.step()));
+        facade.step().unwrap();
+        g.bench_function("facade", |b| b.iter(|| facade.step().unwrap()));
     }
     let mut direct = build_world(&sc, 1).unwrap();
     let robot = direct.robots[0];
@@ -45,7 +45,7 @@ fn swarm_views(c: &mut Criterion) {
     s.run_for(0.2).unwrap();
     let mut g = c.benchmark_group("swarm_1000");
     g.sample_size(20);
-    g.bench_function("tick", |b| b.iter(|| s.step()));
+    g.bench_function("tick", |b| b.iter(|| s.step().unwrap()));
     g.bench_function("read_poses_and_scans", |b| {
         b.iter(|| {
             let mut beams = 0;

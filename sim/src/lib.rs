@@ -41,7 +41,7 @@ pub mod stats;
 
 pub use run::exports::RunExports;
 pub use run::{
-    Command, Finished, RunOptions, RunOutput, SimError, Simulation, SimulationBuilder,
-    run_scenario, run_scenario_exporting,
+    Command, Controller, Finished, Observation, RunOptions, RunOutput, SimError, Simulation,
+    SimulationBuilder, run_scenario, run_scenario_exporting,
 };
 pub use scenario::{Scenario, load_scenario, parse_scenario};

@@ -2,8 +2,8 @@
 //! errors), the scenario type, and the `systems` prelude.
 
 pub use crate::run::{
-    Command, Estimate, Finished, LocalizerView, NavigationView, RobotView, ScanView, SimError,
-    Simulation, SimulationBuilder, Twist,
+    Command, Controller, Estimate, Finished, LocalizerView, NavigationView, Observation, RobotView,
+    ScanView, SimError, Simulation, SimulationBuilder, Target, Twist,
 };
 pub use crate::scenario::Scenario;
 pub use systems::prelude::*;

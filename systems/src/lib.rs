@@ -15,5 +15,6 @@ pub mod matching;
 pub mod navigation;
 pub mod prelude;
 pub mod raycast;
+pub mod robot;
 pub mod sensors;
 pub mod world;

@@ -16,8 +16,8 @@ const SYSTEMS_LEVELS: &[&[&str]] = &[
     &["matching"],
     &["localization"],
     &["mapping", "navigation", "eval"],
-    // re-exports from every level
-    &["prelude"],
+    // re-exports from every level, and the robot bundle of components from several
+    &["prelude", "robot"],
 ];
 
 fn src(krate: &str) -> PathBuf {

@@ -8,23 +8,21 @@ use crate::build::script::{EventQueue, ScriptPlugin};
 use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
 use bevy_ecs::prelude::*;
 use systems::body::{
-    DriveCommand, DriveState, Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics,
-    PhysicsPlugin, TruePose, TrueTwist, Walker,
+    Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics, PhysicsPlugin, TruePose, Walker,
 };
-use systems::core::{
-    KernelPool, RobotId, RobotIndex, SimClock, SimPlugin, SimRng, new_schedule, stream_rng,
-};
-use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome, RobotMetrics};
+use systems::core::{KernelPool, SimClock, SimPlugin, SimRng, new_schedule, stream_rng};
+use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome};
 use systems::localization::de_filter::DeFilter;
 use systems::localization::de_mc::DeMc;
 use systems::localization::de_odometry::DeOdometry;
 use systems::localization::{
-    Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavBelief,
-    NavSource, OdometryModel, ScanEstimator, WheelOdometry,
+    Filter, LocalizationMap, LocalizationPlugin, Localizer, Localizers, MarkovGrid, Mcl, NavSource,
+    OdometryModel, ScanEstimator, WheelOdometry,
 };
 use systems::mapping::{GraphSlam, MappingPlugin, RbpfSlam, ScanToMapSlam};
-use systems::navigation::{Behaviour, HeldCommand, NavCostmaps, NavigationPlugin, Navigator};
+use systems::navigation::{Behaviour, NavCostmaps, NavigationPlugin, Navigator};
 use systems::raycast::{Door, Doors, StaticWorld};
+use systems::robot::RobotBundle;
 use systems::sensors::{
     Encoder, EncoderReadings, Laser, LaserScans, LaserTruth, SensorsPlugin, SonarReadings,
     SonarTruth, Sonars,
@@ -63,16 +61,42 @@ pub enum BuildMode {
     Replay,
 }
 
-/// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
-pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
-    build_world_with(scenario, threads, BuildMode::Live)
+/// What a world built from the same scenario hands on to the next one (a restart with another
+/// seed): the parts that do not depend on the seed and take long to compute.
+#[derive(Default)]
+pub struct Reusable {
+    /// The localizers' map with its distance field.
+    localization_map: Option<LocalizationMap>,
+    /// The navigation costmaps.
+    costmaps: Option<NavCostmaps>,
 }
 
-/// [`build_world`] for a live run or a replay.
+impl Reusable {
+    /// Takes the seed-independent parts out of a built world, unless a door has moved (door
+    /// events edit them; the next world starts with every door open).
+    pub fn take(world: &mut World) -> Self {
+        if world.resource::<StaticWorld>().version != 0 {
+            return Reusable::default();
+        }
+        Reusable {
+            localization_map: world.remove_resource::<LocalizationMap>(),
+            costmaps: world.remove_resource::<NavCostmaps>(),
+        }
+    }
+}
+
+/// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
+pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
+    build_world_with(scenario, threads, BuildMode::Live, Reusable::default())
+}
+
+/// [`build_world`] for a live run or a replay, with what an earlier world of the same scenario
+/// left ([`Reusable::take`]; `Reusable::default()` for none).
 pub fn build_world_with(
     scenario: &Scenario,
     threads: usize,
     mode: BuildMode,
+    reuse: Reusable,
 ) -> anyhow::Result<SimWorld> {
     let live = mode == BuildMode::Live;
     let mut world = World::new();
@@ -89,7 +113,11 @@ pub fn build_world_with(
         .filter(|_| live)
         .filter_map(|r| r.navigation.as_ref().map(|n| n.costmap))
         .collect();
-    let costmaps = (!nav_params.is_empty()).then(|| NavCostmaps::new(&static_world, &nav_params));
+    let costmaps = (!nav_params.is_empty()).then(|| {
+        reuse
+            .costmaps
+            .unwrap_or_else(|| NavCostmaps::new(&static_world, &nav_params))
+    });
     world.insert_resource(static_world);
     world.insert_resource(Doors {
         doors: scenario
@@ -108,7 +136,11 @@ pub fn build_world_with(
     if any_localizer {
         // DE localizers ray-cast only; the field is then small and unused
         let max_dist = field_max_dist.unwrap_or(scenario.grid.resolution);
-        world.insert_resource(LocalizationMap::new(scenario.grid.clone(), max_dist));
+        world.insert_resource(
+            reuse
+                .localization_map
+                .unwrap_or_else(|| LocalizationMap::new(scenario.grid.clone(), max_dist)),
+        );
     }
 
     if live {
@@ -235,23 +267,14 @@ fn spawn_robot(
         stream_rng(seed, &r.name, "behaviour"),
     );
     behaviour.tolerance = r.tolerance;
-    let mut e = world.spawn((
-        RobotId(r.name.clone()),
-        RobotIndex(index),
-        TruePose::at(r.start),
-        TrueTwist::default(),
+    let mut e = world.spawn(RobotBundle::new(
+        r.name.clone(),
+        index,
+        r.start,
         r.footprint.clone(),
         r.kinematics.clone(),
-        DriveCommand::default(),
-        HeldCommand::default(),
-        DriveState::default(),
         body,
         behaviour,
-        NavBelief {
-            pose: r.start,
-            stamp: 0.0,
-        },
-        RobotMetrics::default(),
     ));
     if let Some(spec) = &r.laser {
         e.insert((

@@ -1,6 +1,6 @@
 //! Script set: timed scenario events fire at the first tick starting at or after their time:
 //! new waypoints, teleporting (kidnapping) a robot, sensor faults on and off, held velocity
-//! commands and their release, doors opening and closing. A door edits the static world (ray map, colliders, navigation costmaps follow its
+//! commands and their release, new navigation tasks, doors opening and closing. A door edits the static world (ray map, colliders, navigation costmaps follow its
 //! version) and the map the localizers believe in: the building tells its robots.
 
 use crate::scenario::{Event, EventAction, RobotConfig, SensorName};
@@ -9,7 +9,7 @@ use systems::body::DriveCommand;
 use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::{SimClock, SimPlugin, SimSet};
 use systems::localization::LocalizationMap;
-use systems::navigation::{Behaviour, HeldCommand};
+use systems::navigation::{Behaviour, HeldCommand, Navigator};
 use systems::raycast::{Doors, StaticWorld};
 use systems::sensors::{Encoder, Laser, Sonars};
 
@@ -77,6 +77,7 @@ pub fn fire_events(
         Option<&mut Encoder>,
         Option<&mut Sonars>,
         Option<&mut HeldCommand>,
+        Option<&mut Navigator>,
     )>,
 ) {
     let now = clock.start();
@@ -93,7 +94,7 @@ pub fn fire_events(
             queue.fired.push((now, String::new(), what));
             continue;
         }
-        let Some(Ok((behaviour, body, mut truth, laser, encoder, sonars, held))) =
+        let Some(Ok((behaviour, body, mut truth, laser, encoder, sonars, held, navigator))) =
             entity.map(|e| robots.get_mut(e))
         else {
             continue;
@@ -147,6 +148,14 @@ pub fn fire_events(
                 let Some(mut held) = held else { continue };
                 held.0 = None;
                 "drive command released".to_string()
+            }
+            EventAction::Tasks(tasks) => {
+                let Some(mut navigator) = navigator else {
+                    continue; // resolve and the facade reject this
+                };
+                navigator.tasks.extend(tasks.iter().cloned());
+                let names: Vec<&str> = tasks.iter().map(|t| t.name.as_str()).collect();
+                format!("new tasks: {}", names.join(", "))
             }
             EventAction::Door { .. } => continue, // handled above
         };

@@ -32,7 +32,7 @@ pub use feed::{ReplayFeed, ReplayFeedPlugin, feed_recorded};
 pub use plan::{ReplayPlan, plan};
 pub use source::{RobotFeed, TopicFlags};
 
-use crate::build::{BuildMode, SimWorld, build_world_with};
+use crate::build::{BuildMode, Reusable, SimWorld, build_world_with};
 use crate::record::mcap::McapRecording;
 use crate::run::exports::RunExports;
 use crate::run::report::report_run;
@@ -62,7 +62,7 @@ pub fn build_replay(plan: ReplayPlan, threads: usize) -> anyhow::Result<(SimWorl
     let ReplayPlan {
         scenario, feeds, ..
     } = plan;
-    let mut sim = build_world_with(&scenario, threads, BuildMode::Replay)?;
+    let mut sim = build_world_with(&scenario, threads, BuildMode::Replay, Reusable::default())?;
     let mut robots = Vec::with_capacity(feeds.len());
     for (&entity, feed) in sim.robots.iter().zip(feeds) {
         if !feed.odometry.is_empty() {

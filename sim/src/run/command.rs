@@ -4,6 +4,7 @@
 
 use crate::scenario::{EventAction, SensorName};
 use systems::core::Pose2;
+use systems::navigation::{Goal, Task, TaskKind};
 
 /// What a robot is told to do.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,10 +23,24 @@ pub enum Command {
     Drive { v: f64, w: f64 },
     /// Drops the held velocity command: the behaviour or navigator drives again.
     Release,
+    /// Sends a navigating robot (one with tasks) to a place or a point: a `go` task appended
+    /// to its queue, planned and driven once the tasks before it are done.
+    GoTo(Target),
+    /// Appends tasks (deliveries, trips, waits) to a navigating robot's queue.
+    Tasks(Vec<Task>),
+}
+
+/// Where a robot is sent.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Target {
+    /// A named place of the scenario's map.
+    Place(String),
+    /// A point of the map (m).
+    Point([f64; 2]),
 }
 
 /// Why the facade refused a request.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum SimError {
     #[error("no robot named `{name}` (robots: {known})")]
     UnknownRobot { name: String, known: String },
@@ -35,6 +50,10 @@ pub enum SimError {
     NoSuchSensor { robot: String, sensor: String },
     #[error("robot `{robot}` follows navigation tasks, not waypoints")]
     NotOnWaypoints { robot: String },
+    #[error("robot `{robot}` has no task queue (a robot with `[[robots.tasks]]` takes tasks)")]
+    NotNavigating { robot: String },
+    #[error("no place named `{name}` (places: {known})")]
+    UnknownPlace { name: String, known: String },
     #[error("{what}: expected {expected}, got {got}")]
     BadValue {
         what: String,
@@ -43,6 +62,13 @@ pub enum SimError {
     },
     #[error("{what} ({x}, {y}) would place the robot inside an obstacle")]
     InsideObstacle { what: String, x: f64, y: f64 },
+    #[error("the controller of robot `{robot}` {what} at tick {tick} (t = {time} s)")]
+    ControllerFailed {
+        robot: String,
+        tick: u64,
+        time: f64,
+        what: String,
+    },
     #[error("{what} ({x}, {y}) is outside the map ({bounds})")]
     OutsideMap {
         what: String,
@@ -93,6 +119,67 @@ impl Command {
                 Ok(EventAction::Drive { v, w })
             }
             Command::Release => Ok(EventAction::ReleaseDrive),
+            Command::GoTo(Target::Point(p)) => {
+                finite(format!("goal of `{robot}`"), &p)?;
+                let name = format!("({:.2}, {:.2})", p[0], p[1]);
+                let pose = Pose2::new(p[0], p[1], 0.0);
+                Ok(EventAction::Tasks(vec![go_task(name, pose)]))
+            }
+            Command::GoTo(Target::Place(name)) => Err(SimError::UnknownPlace {
+                name,
+                known: String::new(), // the facade resolves places before this
+            }),
+            Command::Tasks(tasks) => {
+                if tasks.is_empty() {
+                    return Err(SimError::BadValue {
+                        what: format!("tasks of `{robot}`"),
+                        expected: "at least one task",
+                        got: "none".into(),
+                    });
+                }
+                for t in &tasks {
+                    let what = format!("task `{}` of `{robot}`", t.name);
+                    match &t.kind {
+                        TaskKind::Delivery {
+                            from,
+                            to,
+                            load,
+                            unload,
+                        } => {
+                            finite(what.clone(), &[from.pose.x, from.pose.y, to.pose.x])?;
+                            finite(what.clone(), &[to.pose.y, *load, *unload])?;
+                            non_negative(&what, &[*load, *unload])?;
+                        }
+                        TaskKind::Go { to } => finite(what, &[to.pose.x, to.pose.y])?,
+                        TaskKind::Wait { time } => {
+                            finite(what.clone(), &[*time])?;
+                            non_negative(&what, &[*time])?;
+                        }
+                    }
+                }
+                Ok(EventAction::Tasks(tasks))
+            }
         }
     }
+}
+
+/// A `go` task to `pose`, named after the goal.
+pub(super) fn go_task(name: String, pose: Pose2) -> Task {
+    Task {
+        name: format!("go_{name}"),
+        kind: TaskKind::Go {
+            to: Goal { name, pose },
+        },
+    }
+}
+
+fn non_negative(what: &str, v: &[f64]) -> Result<(), SimError> {
+    if v.iter().all(|x| *x >= 0.0) {
+        return Ok(());
+    }
+    Err(SimError::BadValue {
+        what: what.to_string(),
+        expected: "times of 0 s or more",
+        got: format!("{v:?}"),
+    })
 }

@@ -31,6 +31,11 @@ pub struct Exported {
 }
 
 impl RunExports {
+    /// Whether any export is asked for.
+    pub fn writes_files(&self) -> bool {
+        self.carmen_out.is_some() || self.save_map.is_some() || self.mcap.is_some()
+    }
+
     /// Writes the exports of a finished run. Maps are judged against the scenario's map: SLAM
     /// systems start at the robot's true start pose, so their map frame is the world frame.
     pub(crate) fn finish(

@@ -7,6 +7,7 @@
 
 pub mod capture;
 pub mod command;
+pub mod controller;
 pub mod exports;
 pub mod interrupt;
 mod outputs;
@@ -30,10 +31,13 @@ use systems::core::{Pose2, RobotIndex};
 
 pub use crate::formats::tum::RobotLocalization;
 pub use capture::ScanCapture;
-pub use command::{Command, SimError};
+pub use command::{Command, SimError, Target};
+pub use controller::{Controller, Observation};
 pub use outputs::output_plugins;
 pub use simulation::{Finished, Simulation, SimulationBuilder};
-pub use view::{Estimate, LocalizerView, NavigationView, RobotView, ScanView, Twist};
+pub use view::{
+    DoorView, Estimate, LocalizerView, NavigationView, PersonView, RobotView, ScanView, Twist,
+};
 
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
@@ -171,7 +175,7 @@ fn run_world(
 ) -> anyhow::Result<RunOutput> {
     let mut sim = Simulation::from_world(sim, scenario.clone(), opts.rrd.as_deref(), exports)?;
     let mut capturer = capture.map(Capturer::new);
-    let stepped = step_to_end(&mut sim, opts, capturer.as_mut());
+    let stepped = step_to_end(&mut sim, opts, capturer.as_mut())?;
     let mut trajectory = stepped.trajectory;
     if opts.trajectory_period.is_some() {
         trajectory.push((sim.time(), truth_poses(sim.world_mut())));
@@ -202,7 +206,7 @@ fn step_to_end(
     sim: &mut Simulation,
     opts: &RunOptions,
     mut capturer: Option<&mut Capturer>,
-) -> Stepped {
+) -> Result<Stepped, SimError> {
     let (duration, dt) = (sim.scenario().duration, sim.scenario().dt);
     let bar = progress::Progress::new(opts.progress, sim.end_tick(), duration, dt);
     let started = Instant::now();
@@ -222,17 +226,17 @@ fn step_to_end(
             }
         }
         let tick = sim.ticks();
-        sim.step();
+        sim.step()?;
         if let Some(c) = capturer.as_deref_mut() {
             c.collect(sim.world_mut());
         }
         bar.tick(tick, started);
     }
     bar.finish();
-    Stepped {
+    Ok(Stepped {
         interrupted,
         trajectory,
-    }
+    })
 }
 
 fn truth_poses(w: &mut World) -> Vec<Pose2> {

@@ -15,13 +15,14 @@
 //! # anyhow::Ok(())
 //! ```
 
-use super::command::{Command, SimError};
+use super::command::{Command, SimError, Target, go_task};
+use super::controller::{Controlled, Controller, UserControllers, run_user_controllers};
 use super::exports::{Exported, RunExports};
 use super::outputs;
 use super::summary::{Summary, collect};
-use super::view::{DoorView, RobotView};
+use super::view::{DoorView, PersonView, RobotView};
 use crate::build::script::EventQueue;
-use crate::build::{SimWorld, build_world};
+use crate::build::{BuildMode, Reusable, SimWorld, build_world, build_world_with};
 use crate::formats::tum::RobotLocalization;
 use crate::options::check_duration;
 use crate::scenario::overrides::Override;
@@ -30,15 +31,29 @@ use crate::scenario::{Event, EventAction, Scenario, load_scenario, scenario_path
 use bevy_ecs::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use systems::navigation::Navigator;
+use systems::body::people::walk_people;
+use systems::body::{PersonId, TruePose, Walker};
+use systems::core::SimSet;
+use systems::eval::{LocalizationSamples, NavOutcome};
+use systems::localization::WheelOdometry;
+use systems::localization::{Filter, Localizer, Localizers, ScanEstimator};
+use systems::navigation::behaviour::drive_behaviours;
+use systems::navigation::held::apply_held_commands;
 use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
+use systems::navigation::{Behaviour, Navigator};
 use systems::raycast::Doors;
+use systems::sensors::Laser;
 
 /// A running simulation of one scenario.
 pub struct Simulation {
     sim: SimWorld,
     scenario: Scenario,
     exports: RunExports,
+    /// Whether a recording or export is being written (a restart would overwrite it).
+    writes_files: bool,
+    threads: usize,
+    /// The user's estimators as given (before any scan), for a restart.
+    estimators: Vec<(String, String, Filter)>,
     /// Ticks run so far.
     ticks: u64,
     /// When the first tick started (the summary's wall time counts from there).
@@ -78,6 +93,10 @@ pub struct SimulationBuilder {
     threads: usize,
     rrd: Option<PathBuf>,
     exports: RunExports,
+    /// User controllers by robot name.
+    controllers: Vec<(String, Box<dyn Controller>)>,
+    /// User estimators: robot name, the estimator's name, the estimator.
+    estimators: Vec<(String, String, Filter)>,
 }
 
 impl SimulationBuilder {
@@ -90,6 +109,8 @@ impl SimulationBuilder {
             threads: 0,
             rrd: None,
             exports: RunExports::default(),
+            controllers: Vec::new(),
+            estimators: Vec::new(),
         }
     }
 
@@ -152,6 +173,32 @@ impl SimulationBuilder {
         self
     }
 
+    /// Drives robot `robot` with the user's `controller` instead of its behaviour or navigator
+    /// (see [`Controller`]); a held velocity command ([`Command::Drive`]) still overrides it.
+    pub fn controller(mut self, robot: &str, controller: impl Controller) -> Self {
+        self.controllers
+            .push((robot.to_string(), Box::new(controller)));
+        self
+    }
+
+    /// Adds a user's SLAM system (or any estimator fed with scans and odometry) called `name`
+    /// to robot `robot`: it runs in the Map set after the scenario's own, and is evaluated,
+    /// summarised, recorded and exported like them under `name`. The robot needs a laser and
+    /// wheel encoders.
+    pub fn slam(
+        mut self,
+        robot: &str,
+        name: &str,
+        estimator: impl ScanEstimator + 'static,
+    ) -> Self {
+        self.estimators.push((
+            robot.to_string(),
+            name.to_string(),
+            Filter::Scan(Box::new(estimator)),
+        ));
+        self
+    }
+
     /// The scenario with every override applied and validated.
     pub fn scenario(&self) -> anyhow::Result<Scenario> {
         let overrides = self
@@ -191,9 +238,119 @@ impl SimulationBuilder {
     /// Builds the world, opens the outputs' files and adds their recorders to the schedule.
     pub fn build(self) -> anyhow::Result<Simulation> {
         let scenario = self.scenario()?;
-        let world = build_world(&scenario, self.threads)?;
-        Simulation::from_world(world, scenario, self.rrd.as_deref(), &self.exports)
+        let mut world = build_world(&scenario, self.threads)?;
+        attach_estimators(&mut world, &scenario, self.estimators.clone())?;
+        attach_controllers(&mut world, &scenario, self.controllers)?;
+        let mut sim = Simulation::from_world(world, scenario, self.rrd.as_deref(), &self.exports)?;
+        sim.threads = self.threads;
+        sim.estimators = self.estimators;
+        Ok(sim)
     }
+}
+
+fn robot_entity(
+    sim: &SimWorld,
+    scenario: &Scenario,
+    name: &str,
+) -> Result<(usize, Entity), SimError> {
+    scenario
+        .robots
+        .iter()
+        .position(|r| r.name == name)
+        .map(|i| (i, sim.robots[i]))
+        .ok_or_else(|| SimError::UnknownRobot {
+            name: name.to_string(),
+            known: names(scenario.robots.iter().map(|r| r.name.as_str())),
+        })
+}
+
+/// The user's estimators join their robots' localizers, after the scenario's own (so those
+/// keep their order and random streams).
+fn attach_estimators(
+    sim: &mut SimWorld,
+    scenario: &Scenario,
+    estimators: Vec<(String, String, Filter)>,
+) -> Result<(), SimError> {
+    for (robot, name, filter) in estimators {
+        let (_, e) = robot_entity(sim, scenario, &robot)?;
+        let world = &mut sim.world;
+        for (has, sensor) in [
+            (world.get::<Laser>(e).is_some(), "laser"),
+            (world.get::<WheelOdometry>(e).is_some(), "encoder"),
+        ] {
+            if !has {
+                return Err(SimError::NoSuchSensor {
+                    robot,
+                    sensor: format!("{sensor} (estimator `{name}` needs one)"),
+                });
+            }
+        }
+        if name.is_empty()
+            || world
+                .get::<Localizers>(e)
+                .is_some_and(|l| l.items.iter().any(|l| l.name == name))
+        {
+            return Err(SimError::BadValue {
+                what: format!("estimator name on `{robot}`"),
+                expected: "a name no other localizer of the robot has",
+                got: format!("`{name}`"),
+            });
+        }
+        let mut ent = world.entity_mut(e);
+        if !ent.contains::<Localizers>() {
+            ent.insert((Localizers::default(), LocalizationSamples::default()));
+        }
+        ent.get_mut::<Localizers>()
+            .expect("inserted above")
+            .items
+            .push(Localizer::new(name, filter));
+    }
+    Ok(())
+}
+
+/// The user's controllers replace their robots' behaviours and navigators, and run in the
+/// Control set after the built-in drivers, before held commands.
+fn attach_controllers(
+    sim: &mut SimWorld,
+    scenario: &Scenario,
+    controllers: Vec<(String, Box<dyn Controller>)>,
+) -> Result<(), SimError> {
+    if controllers.is_empty() {
+        return Ok(());
+    }
+    let mut items: Vec<Controlled> = Vec::with_capacity(controllers.len());
+    for (robot, controller) in controllers {
+        let (index, entity) = robot_entity(sim, scenario, &robot)?;
+        if items.iter().any(|c| c.index == index) {
+            return Err(SimError::BadValue {
+                what: format!("controllers of `{robot}`"),
+                expected: "one controller per robot",
+                got: "two".into(),
+            });
+        }
+        sim.world
+            .entity_mut(entity)
+            .remove::<(Behaviour, Navigator, NavOutcome, RoadNavigator)>();
+        items.push(Controlled {
+            entity,
+            index,
+            name: robot,
+            controller,
+        });
+    }
+    items.sort_by_key(|c| c.index);
+    sim.world.insert_resource(UserControllers {
+        items,
+        failure: None,
+    });
+    sim.schedule.add_systems(
+        run_user_controllers
+            .in_set(SimSet::Control)
+            .after(drive_behaviours)
+            .after(walk_people)
+            .before(apply_held_commands),
+    );
+    Ok(())
 }
 
 impl Simulation {
@@ -229,10 +386,51 @@ impl Simulation {
         Ok(Simulation {
             sim,
             scenario,
+            writes_files: rrd.is_some() || exports.writes_files(),
             exports: exports.clone(),
+            threads: 0,
+            estimators: Vec::new(),
             ticks: 0,
             started: None,
         })
+    }
+
+    /// Starts the same scenario again from its first tick with seed `seed`: the result equals
+    /// a simulation built afresh with that seed. What does not depend on the seed (the
+    /// localizers' distance field, the navigation costmaps) is reused unless a door has moved.
+    /// The user's controllers are kept as they are (with their own state); the user's
+    /// estimators start again as they were given. A simulation writing recordings or exports
+    /// cannot restart (it would overwrite them): build a new one.
+    pub fn reset(&mut self, seed: u64) -> anyhow::Result<()> {
+        if self.writes_files {
+            anyhow::bail!(
+                "reset: this simulation writes recordings or exports; build a new one for \
+                 another seed"
+            );
+        }
+        let reuse = Reusable::take(&mut self.sim.world);
+        let controllers = self
+            .sim
+            .world
+            .remove_resource::<UserControllers>()
+            .map(|c| {
+                c.items
+                    .into_iter()
+                    .map(|c| (c.name, c.controller))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let mut scenario = self.scenario.clone();
+        scenario.seed = seed;
+        let mut world = build_world_with(&scenario, self.threads, BuildMode::Live, reuse)?;
+        attach_estimators(&mut world, &scenario, self.estimators.clone())?;
+        attach_controllers(&mut world, &scenario, controllers)?;
+        outputs::install(&mut world, &scenario, None, &RunExports::default())?;
+        self.sim = world;
+        self.scenario = scenario;
+        self.ticks = 0;
+        self.started = None;
+        Ok(())
     }
 
     /// The scenario being run.
@@ -255,11 +453,23 @@ impl Simulation {
         (self.scenario.duration / self.scenario.dt).round().max(1.0) as u64
     }
 
-    /// One tick of the schedule.
-    pub fn step(&mut self) {
+    /// One tick of the schedule. An error once a user controller has failed (the run can
+    /// still be [finished](Simulation::finish), its recordings complete up to that tick).
+    pub fn step(&mut self) -> Result<(), SimError> {
+        self.failure()?;
         self.started.get_or_insert_with(Instant::now);
         self.sim.step();
         self.ticks += 1;
+        self.failure()
+    }
+
+    fn failure(&self) -> Result<(), SimError> {
+        match self.sim.world.get_resource::<UserControllers>() {
+            Some(UserControllers {
+                failure: Some(e), ..
+            }) => Err(e.clone()),
+            _ => Ok(()),
+        }
     }
 
     /// The scenario's duration is over, or it ends when every task is done and they are.
@@ -275,7 +485,7 @@ impl Simulation {
     /// duration.
     pub fn run_for(&mut self, seconds: f64) -> Result<(), SimError> {
         for _ in 0..self.ticks_in(seconds)? {
-            self.step();
+            self.step()?;
         }
         Ok(())
     }
@@ -291,7 +501,7 @@ impl Simulation {
             if done(self) {
                 return Ok(true);
             }
-            self.step();
+            self.step()?;
         }
         Ok(done(self))
     }
@@ -307,10 +517,14 @@ impl Simulation {
         Ok((seconds / self.scenario.dt).round() as u64)
     }
 
-    /// Steps to the scenario's end, then [`Simulation::finish`].
+    /// Steps to the scenario's end, then [`Simulation::finish`]. If a user controller fails,
+    /// the run is finished where it stopped (recordings written) and the error returned.
     pub fn run(mut self) -> anyhow::Result<Finished> {
         while !self.is_over() {
-            self.step();
+            if let Err(e) = self.step() {
+                self.finish()?;
+                return Err(e.into());
+            }
         }
         self.finish()
     }
@@ -373,6 +587,22 @@ impl Simulation {
             })
     }
 
+    /// The walking people, in the scenario's order.
+    pub fn people(&self) -> Vec<PersonView<'_>> {
+        let w = &self.sim.world;
+        self.sim
+            .people
+            .iter()
+            .filter_map(|&e| {
+                Some(PersonView {
+                    name: &w.get::<PersonId>(e)?.0,
+                    pose: w.get::<TruePose>(e)?.pose,
+                    next_point: w.get::<Walker>(e)?.next,
+                })
+            })
+            .collect()
+    }
+
     /// The world's doors and whether each is open.
     pub fn doors(&self) -> Vec<DoorView> {
         self.sim
@@ -394,7 +624,30 @@ impl Simulation {
     pub fn command(&mut self, robot: &str, command: Command) -> Result<(), SimError> {
         let index = self.robot_index(robot)?;
         let config = &self.scenario.robots[index];
+        let command = match command {
+            Command::GoTo(Target::Place(name)) => {
+                let Some(pose) = self.scenario.places.get(&name) else {
+                    return Err(SimError::UnknownPlace {
+                        known: names(self.scenario.places.keys().map(String::as_str)),
+                        name,
+                    });
+                };
+                Command::Tasks(vec![go_task(name, *pose)])
+            }
+            c => c,
+        };
         match &command {
+            Command::GoTo(_) | Command::Tasks(_)
+                if self
+                    .sim
+                    .world
+                    .get::<Navigator>(self.sim.robots[index])
+                    .is_none() =>
+            {
+                return Err(SimError::NotNavigating {
+                    robot: robot.to_string(),
+                });
+            }
             Command::Waypoints { .. } if config.navigation.is_some() => {
                 return Err(SimError::NotOnWaypoints {
                     robot: robot.to_string(),
@@ -432,6 +685,22 @@ impl Simulation {
             EventAction::Waypoints { points, .. } => {
                 for (i, p) in points.iter().enumerate() {
                     self.check_inside(&format!("waypoint {i} of `{robot}`"), p[0], p[1])?;
+                }
+            }
+            EventAction::Tasks(tasks) => {
+                let radius = config.footprint.bounding_radius();
+                for t in tasks {
+                    for g in t.goals() {
+                        let what = format!("goal `{}` of task `{}` of `{robot}`", g.name, t.name);
+                        self.check_inside(&what, g.pose.x, g.pose.y)?;
+                        if !self.scenario.grid.disc_is_clear(g.pose.x, g.pose.y, radius) {
+                            return Err(SimError::InsideObstacle {
+                                what,
+                                x: g.pose.x,
+                                y: g.pose.y,
+                            });
+                        }
+                    }
                 }
             }
             _ => {}

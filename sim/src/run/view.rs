@@ -5,8 +5,11 @@
 use bevy_ecs::prelude::*;
 use systems::body::{Collisions, TruePose, TrueTwist};
 use systems::core::Pose2;
-use systems::eval::RobotMetrics;
-use systems::localization::{Localizers, WheelOdometry};
+use systems::eval::localization_metrics::CONVERGENCE_HOLD_S;
+use systems::eval::trajectory::convergence_index;
+use systems::eval::{LocalizationSamples, RobotMetrics};
+use systems::localization::{Filter, Localizers, WheelOdometry};
+use systems::matching::ProbGrid;
 use systems::navigation::Navigator;
 use systems::navigation::navigator::Phase;
 use systems::sensors::camera::CameraFrame;
@@ -106,6 +109,7 @@ impl<'w> RobotView<'w> {
 
     /// Every localizer and SLAM system of the robot, in the scenario's order.
     pub fn localizers(&self) -> Vec<LocalizerView<'w>> {
+        let samples = self.get::<LocalizationSamples>();
         self.get::<Localizers>().map_or(Vec::new(), |l| {
             l.items
                 .iter()
@@ -117,6 +121,12 @@ impl<'w> RobotView<'w> {
                         pose: e.estimate.pose,
                         covariance: e.estimate.covariance,
                     }),
+                    converged_after: samples
+                        .and_then(|s| s.per_localizer.iter().find(|(n, _)| *n == l.name))
+                        .and_then(|(_, s)| {
+                            convergence_index(s, CONVERGENCE_HOLD_S).map(|i| s[i].t)
+                        }),
+                    filter: &l.filter,
                 })
                 .collect()
         })
@@ -210,6 +220,44 @@ pub struct LocalizerView<'w> {
     pub kind: &'static str,
     /// The latest estimate (None before its first).
     pub estimate: Option<Estimate>,
+    /// When its estimates came and stayed close to the truth (the summary's convergence,
+    /// judged on the estimates so far; s), None if not (yet).
+    pub converged_after: Option<f64>,
+    filter: &'w Filter,
+}
+
+impl LocalizerView<'_> {
+    /// A SLAM system's map so far (P(occupied) per cell, map frame), None for localizers.
+    pub fn map(&self) -> Option<ProbGrid> {
+        match self.filter {
+            Filter::Scan(e) => e.map(),
+            _ => None,
+        }
+    }
+
+    /// A SLAM system's best trajectory so far (stamp, pose), empty for localizers.
+    pub fn trajectory(&self) -> Vec<(f64, Pose2)> {
+        match self.filter {
+            Filter::Scan(e) => e.trajectory(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The algorithm itself, for programs that know its type ([`Filter`]).
+    pub fn filter(&self) -> &Filter {
+        self.filter
+    }
+}
+
+/// A walking person.
+#[derive(Clone, Copy, Debug)]
+pub struct PersonView<'w> {
+    /// The name given in the scenario.
+    pub name: &'w str,
+    /// Where the person is (ground truth).
+    pub pose: Pose2,
+    /// The route point the person walks to next.
+    pub next_point: usize,
 }
 
 /// A robot's navigator.

@@ -1,5 +1,5 @@
-//! `[[events]]`: timed scenario events (routes, kidnapping, sensor faults, doors), checked
-//! against the robots, doors and map they concern.
+//! `[[events]]`: timed scenario events (routes, kidnapping, sensor faults, doors, held drive
+//! commands, new navigation tasks), checked against the robots, doors and map they concern.
 
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
@@ -19,6 +19,7 @@ pub enum EventType {
     Door,
     Drive,
     Release,
+    Tasks,
 }
 
 #[derive(Deserialize, Debug)]
@@ -46,12 +47,15 @@ pub struct EventFile {
     // drive: the held velocity command (m/s, rad/s)
     pub v: Option<f64>,
     pub w: Option<f64>,
+    /// tasks: appended to the robot's task queue (same tables as `[[robots.tasks]]`)
+    pub tasks: Option<Vec<super::navigation::TaskFile>>,
 }
 
 impl EventFile {
     /// The keys of waypoints, teleport and sensor_fault events, and whether each is given.
-    fn route_pose_and_sensor_keys(&self) -> [(&'static str, bool); 5] {
+    fn route_pose_and_sensor_keys(&self) -> [(&'static str, bool); 6] {
         [
+            ("tasks", self.tasks.is_some()),
             ("points", self.points.is_some()),
             ("loop", self.looping.is_some()),
             ("pose", self.pose.is_some()),
@@ -155,6 +159,9 @@ fn resolve_robot_event(
     points: &PointList,
 ) -> R<EventAction> {
     let Known { robots, grid, .. } = known;
+    if e.kind != EventType::Tasks && e.tasks.is_some() {
+        return c.err(&p.key("tasks"), "`tasks` applies to `tasks` events only");
+    }
     if e.door.is_some() || e.open.is_some() {
         let key = if e.door.is_some() { "door" } else { "open" };
         return c.err(
@@ -247,6 +254,41 @@ fn resolve_robot_event(
                 sensor,
                 active: e.active.unwrap_or(true),
             }
+        }
+        EventType::Tasks => {
+            if robot.navigation.is_none() {
+                return c.err(
+                    &p.key("robot"),
+                    format!(
+                        "robot `{}` has no task queue: give it `[[robots.tasks]]` (and \
+                         `[robots.navigation]`) to send it tasks",
+                        robot.name
+                    ),
+                );
+            }
+            let Some(tasks) = e.tasks.as_ref().filter(|t| !t.is_empty()) else {
+                return c.err(
+                    p,
+                    "a tasks event needs `tasks` (at least one, as in `[[robots.tasks]]`)",
+                );
+            };
+            for (key, present) in e.route_pose_and_sensor_keys().into_iter().skip(1) {
+                only(key, present, "tasks")?;
+            }
+            let radius = robot.footprint.bounding_radius();
+            let goal = |path: &KeyPath, v: &PointOrPlace| -> R<Pose2> {
+                let pose = point(path, v)?;
+                inside(path, &pose)?;
+                super::navigation::goal_clear(c, path, grid, &pose, radius)?;
+                Ok(pose)
+            };
+            let tp = p.key("tasks");
+            let tasks = tasks
+                .iter()
+                .enumerate()
+                .map(|(i, t)| super::navigation::resolve_task(c, &tp.index(i), t, i, &goal))
+                .collect::<R<Vec<_>>>()?;
+            EventAction::Tasks(tasks)
         }
         EventType::Drive | EventType::Release => {
             let kind = if e.kind == EventType::Drive {

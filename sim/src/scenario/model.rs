@@ -134,6 +134,8 @@ pub enum EventAction {
     },
     /// The held command is dropped: the behaviour or navigator drives again.
     ReleaseDrive,
+    /// Tasks appended to a navigating robot's queue.
+    Tasks(Vec<systems::navigation::Task>),
 }
 
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]

@@ -56,6 +56,26 @@ pub struct TaskFile {
     pub time: Option<f64>,
 }
 
+/// Checks that a goal leaves room for a robot of radius `radius` (m).
+pub(super) fn goal_clear(
+    c: &Checker,
+    path: &KeyPath,
+    grid: &systems::world::OccupancyGrid,
+    pose: &Pose2,
+    radius: f64,
+) -> R<()> {
+    if !grid.disc_is_clear(pose.x, pose.y, radius) {
+        return c.err(
+            path,
+            format!(
+                "the goal ({:.2}, {:.2}) is too close to an obstacle for the robot (radius {radius:.2} m)",
+                pose.x, pose.y
+            ),
+        );
+    }
+    Ok(())
+}
+
 /// A robot's navigation, resolved.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NavConfig {
@@ -200,7 +220,7 @@ pub(super) fn resolve_navigation(
     }))
 }
 
-fn resolve_task(
+pub(super) fn resolve_task(
     c: &Checker,
     p: &KeyPath,
     t: &TaskFile,

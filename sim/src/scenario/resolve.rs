@@ -418,20 +418,7 @@ fn resolve_robot(
         },
         &|path, v| {
             let pose = w.point_inside(path, v)?;
-            if !w
-                .grid
-                .disc_is_clear(pose.x, pose.y, footprint.bounding_radius())
-            {
-                return c.err(
-                    path,
-                    format!(
-                        "the goal ({:.2}, {:.2}) is too close to an obstacle for the robot (radius {:.2} m)",
-                        pose.x,
-                        pose.y,
-                        footprint.bounding_radius()
-                    ),
-                );
-            }
+            super::navigation::goal_clear(c, path, w.grid, &pose, footprint.bounding_radius())?;
             Ok(pose)
         },
     )?;

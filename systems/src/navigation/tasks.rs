@@ -50,6 +50,15 @@ impl Task {
         matches!(self.kind, TaskKind::Delivery { .. })
     }
 
+    /// The places the task drives to, in order.
+    pub fn goals(&self) -> Vec<&Goal> {
+        match &self.kind {
+            TaskKind::Delivery { from, to, .. } => vec![from, to],
+            TaskKind::Go { to } => vec![to],
+            TaskKind::Wait { .. } => Vec::new(),
+        }
+    }
+
     /// The task's steps, in order.
     pub fn steps(&self) -> Vec<Step> {
         match &self.kind {

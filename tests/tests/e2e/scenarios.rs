@@ -159,6 +159,40 @@ fn semantic_errors() {
         e.contains("`pose` does not apply to a `release` event"),
         "{e}"
     );
+    // new tasks
+    let e = scenario_error(&event(
+        "type = \"tasks\"\ntasks = [{ type = \"go\", to = [2.0, 2.0] }]\n",
+    ));
+    assert!(
+        e.contains("events[0].robot") && e.contains("no task queue"),
+        "{e}"
+    );
+    let navigating = |body: &str| {
+        format!(
+            "{}\n[[events]]\nat = 0.5\nrobot = \"r1\"\n{body}",
+            with_robot(
+                "[robots.sensors.laser]\n[robots.sensors.encoder]\n\
+                 [[robots.tasks]]\ntype = \"wait\"\ntime = 1.0\n"
+            )
+        )
+    };
+    let e = scenario_error(&navigating("type = \"tasks\"\n"));
+    assert!(e.contains("a tasks event needs `tasks`"), "{e}");
+    let e = scenario_error(&navigating(
+        "type = \"tasks\"\ntasks = [{ type = \"go\", to = [0.05, 5.0] }]\n",
+    ));
+    assert!(
+        e.contains("events[0].tasks[0].to") && e.contains("too close to an obstacle"),
+        "{e}"
+    );
+    let e = scenario_error(&navigating(
+        "type = \"tasks\"\ntasks = [{ type = \"go\", to = [2.0, 2.0] }]\nv = 1.0\n",
+    ));
+    assert!(e.contains("`v` applies to `drive` events only"), "{e}");
+    let e = scenario_error(&navigating(
+        "type = \"teleport\"\npose = [2.0, 2.0, 0.0]\ntasks = []\n",
+    ));
+    assert!(e.contains("`tasks` applies to `tasks` events only"), "{e}");
     // no world
     let e = scenario_error("duration = 3.0\n");
     assert!(e.contains("world is empty"), "{e}");

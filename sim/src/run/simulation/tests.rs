@@ -3,7 +3,7 @@
 //! it concerns.
 
 use super::*;
-use crate::run::{RunOptions, run_scenario};
+use crate::run::{RunOptions, Target, run_scenario};
 use crate::scenario::{SensorName, assets_dir, find_scenario};
 use systems::core::Pose2;
 
@@ -130,10 +130,10 @@ robot = "r3"
 
     let mut file = file;
     while !file.is_over() {
-        file.step();
+        file.step().unwrap();
     }
     while !scripted.is_over() {
-        scripted.step();
+        scripted.step().unwrap();
     }
     assert_eq!(scripted.ticks(), 140);
     assert_eq!(fingerprint(&mut file), fingerprint(&mut scripted));
@@ -331,7 +331,7 @@ fn a_door_closes_at_the_next_tick() {
     assert!(door.open);
     s.set_door(&door.name, false).unwrap();
     assert!(s.doors()[0].open, "not before the next tick");
-    s.step();
+    s.step().unwrap();
     assert!(!s.doors()[0].open);
     // a robot with navigation tasks takes goals, not waypoints
     let route = Command::Waypoints {
@@ -344,4 +344,147 @@ fn a_door_closes_at_the_next_tick() {
         Err(SimError::NotOnWaypoints { robot: r1.clone() })
     );
     assert!(s.robot(&r1).unwrap().navigation().is_some());
+}
+
+/// One navigating robot in the hospital, on a trip to the west corridor.
+const COURIER: &str = r#"
+name = "courier"
+seed = 5
+duration = 20.0
+[map]
+file = "../maps/hospital/hospital.yaml"
+places = "../maps/hospital/places.toml"
+[[robots]]
+name = "r1"
+start = "charger_1"
+footprint = { circle = 0.3 }
+navigation = { speed = 0.8 }
+[robots.sensors.laser]
+preset = "sick_lms100"
+[robots.sensors.encoder]
+[[robots.tasks]]
+type = "go"
+to = "corridor_main_w"
+"#;
+
+fn navigation_fingerprint(s: &mut Simulation) -> String {
+    let r = s.robot("r1").unwrap();
+    let n = r.navigation().unwrap();
+    let nav = format!("{} {} {}", n.tasks(), n.tasks_done(), n.status());
+    format!("{}{nav}", fingerprint(s))
+}
+
+#[test]
+fn a_goal_sent_by_the_program_equals_a_tasks_event_in_the_file() {
+    let events = r#"
+[[events]]
+at = 1.0
+type = "tasks"
+robot = "r1"
+tasks = [{ type = "go", name = "go_corridor_main_c", to = "corridor_main_c" }]
+"#;
+    let mut file = from_text(&format!("{COURIER}{events}"), "file")
+        .build()
+        .unwrap();
+    let mut scripted = from_text(COURIER, "scripted").build().unwrap();
+    scripted.run_for(1.0).unwrap();
+    file.run_for(1.0).unwrap();
+    scripted
+        .command("r1", Command::GoTo(Target::Place("corridor_main_c".into())))
+        .unwrap();
+    for _ in 0..3 {
+        file.run_for(1.0).unwrap();
+        scripted.run_for(1.0).unwrap();
+        assert_eq!(
+            navigation_fingerprint(&mut file),
+            navigation_fingerprint(&mut scripted)
+        );
+    }
+    assert_eq!(
+        scripted.robot("r1").unwrap().navigation().unwrap().tasks(),
+        2
+    );
+    let (a, b) = (file.finish().unwrap(), scripted.finish().unwrap());
+    assert_eq!(summary_json(&a), summary_json(&b));
+    assert!(
+        b.log
+            .iter()
+            .any(|(_, _, what)| what == "new tasks: go_corridor_main_c"),
+        "{:?}",
+        b.log
+    );
+}
+
+#[test]
+fn bad_goals_are_typed_errors() {
+    let mut s = from_text(COURIER, "courier").build().unwrap();
+    let go = |t: Target| Command::GoTo(t);
+    assert!(matches!(
+        s.command("r1", go(Target::Place("moon".into()))),
+        Err(SimError::UnknownPlace { name, known }) if name == "moon" && known.contains("charger_1")
+    ));
+    assert!(matches!(
+        s.command("r1", go(Target::Point([1e6, 0.0]))),
+        Err(SimError::OutsideMap { .. })
+    ));
+    assert!(matches!(
+        s.command("r1", go(Target::Point([f64::NAN, 0.0]))),
+        Err(SimError::BadValue { .. })
+    ));
+    assert!(matches!(
+        s.command("r1", Command::Tasks(Vec::new())),
+        Err(SimError::BadValue { .. })
+    ));
+    // a wall of the hospital
+    let grid = &s.scenario().grid;
+    let wall = (0..grid.height)
+        .flat_map(|row| (0..grid.width).map(move |col| (col, row)))
+        .find(|&(col, row)| grid.get(col, row) == systems::world::Cell::Occupied)
+        .map(|(col, row)| grid.cell_center(col, row))
+        .unwrap();
+    assert!(matches!(
+        s.command("r1", go(Target::Point(wall))),
+        Err(SimError::InsideObstacle { .. })
+    ));
+    // a robot without tasks takes none
+    let mut p = from_text(&patrol_text(), "patrol").build().unwrap();
+    assert!(matches!(
+        p.command("r1", go(Target::Point([1.0, 1.0]))),
+        Err(SimError::NotNavigating { robot }) if robot == "r1"
+    ));
+}
+
+#[test]
+fn a_reset_equals_a_fresh_simulation_with_that_seed() {
+    // a navigating robot (costmaps reused) and localizers (distance field reused)
+    let text = COURIER.replace(
+        "[[robots.tasks]]",
+        "[[robots.localization]]\nname = \"mcl\"\ntype = \"mcl\"\ninit = \"pose\"\n[[robots.tasks]]",
+    );
+    let mut s = from_text(&text, "courier").build().unwrap();
+    s.run_for(2.0).unwrap();
+    s.reset(9).unwrap();
+    assert_eq!((s.ticks(), s.time(), s.scenario().seed), (0, 0.0, 9));
+    let mut fresh = from_text(&text, "courier").seed(9).build().unwrap();
+    for _ in 0..2 {
+        s.run_for(1.5).unwrap();
+        fresh.run_for(1.5).unwrap();
+        assert_eq!(
+            navigation_fingerprint(&mut s),
+            navigation_fingerprint(&mut fresh)
+        );
+    }
+    let (a, b) = (s.finish().unwrap(), fresh.finish().unwrap());
+    assert_eq!(summary_json(&a), summary_json(&b));
+}
+
+#[test]
+fn a_simulation_writing_files_refuses_to_reset() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut s = from_text(COURIER, "courier")
+        .rrd(dir.path().join("a.rrd"))
+        .build()
+        .unwrap();
+    let e = s.reset(2).unwrap_err().to_string();
+    assert!(e.contains("writes recordings"), "{e}");
 }
