@@ -5,5 +5,5 @@ pub use crate::run::{
     Command, Estimate, Finished, LocalizerView, NavigationView, RobotView, ScanView, SimError,
     Simulation, SimulationBuilder, Twist,
 };
-pub use crate::scenario::Scenario;
+pub use crate::scenario::{RobotBuilder, RobotConfig, Scenario, ScenarioBuilder};
 pub use systems::prelude::*;
