@@ -418,3 +418,105 @@ fn a_built_scenario_runs_as_its_toml() {
     assert_eq!(a.summary.sim_time_s, 2.0);
     assert_eq!(summary_json(&a), summary_json(&b));
 }
+
+#[test]
+fn an_outdoor_world_with_a_route_robot_built_in_code_equals_its_toml() {
+    let text = r#"
+name = "park"
+duration = 10.0
+[roads]
+file = "../roads/park/park.osm"
+reference = [50.0645, 14.418]
+[[zones]]
+name = "transformer"
+kind = "em"
+circle = { center = [46.0, 6.0], radius = 12.0 }
+[[robots]]
+name = "car"
+preset = "thesis_car"
+[robots.route]
+start = "37"
+toward = "19"
+goal = "10"
+speed = 1.0
+"#;
+    let built = Scenario::builder("park")
+        .duration(10.0)
+        .relative_to(assets_dir().join("scenarios"))
+        .roads(RoadsFile {
+            file: "../roads/park/park.osm".into(),
+            reference: Some([50.0645, 14.418]),
+            ..Default::default()
+        })
+        .zone(ZoneFile {
+            name: "transformer".into(),
+            kind: "em".into(),
+            circle: Some(super::super::outdoor::CircleFile {
+                center: [46.0, 6.0],
+                radius: 12.0,
+            }),
+            ..Default::default()
+        })
+        .robot(
+            RobotConfig::builder_on_route(
+                "car",
+                RouteFile {
+                    start: "37".into(),
+                    toward: Some("19".into()),
+                    goal: "10".into(),
+                    speed: Some(1.0),
+                    ..Default::default()
+                },
+            )
+            .preset("thesis_car"),
+        )
+        .build()
+        .unwrap();
+    assert!(built.roads.is_some() && built.robots[0].route.is_some());
+    assert_eq!(fingerprint(built), fingerprint(parse(text).unwrap()));
+}
+
+#[test]
+fn slam_systems_built_in_code_equal_their_toml() {
+    let room = "duration = 1.0\nwalls = [{ from = [0.0, 0.0], to = [6.0, 6.0] }]\n\
+                [[robots]]\nname = \"r\"\nstart = [1.0, 4.0, 0.0]\n\
+                sensors = { laser = {}, encoder = {} }\n";
+    let robot = || {
+        RobotConfig::builder("r", [1.0, 4.0, 0.0])
+            .laser(LaserFile::default())
+            .encoder(EncoderFile::default())
+    };
+    let build = |r: RobotBuilder| {
+        Scenario::builder("t")
+            .duration(1.0)
+            .wall([0.0, 0.0], [6.0, 6.0])
+            .robot(r)
+            .build()
+    };
+    // one system is the `slam = { … }` table
+    let one = build(robot().slam(SlamFile {
+        resolution: Some(0.1),
+        ..SlamFile::of_type(SlamType::Graph)
+    }))
+    .unwrap();
+    let file = parse(&format!(
+        "{room}slam = {{ type = \"graph\", resolution = 0.1 }}\n"
+    ))
+    .unwrap();
+    assert_eq!(fingerprint(one), fingerprint(file));
+    // several are `[[robots.slam]]` tables, and their errors name the index
+    let two = build(
+        robot()
+            .slam(SlamFile::of_type(SlamType::ScanToMap))
+            .slam(SlamFile {
+                resolution: Some(0.0),
+                ..SlamFile::of_type(SlamType::Rbpf)
+            }),
+    )
+    .unwrap_err();
+    let file = parse(&format!(
+        "{room}[[robots.slam]]\ntype = \"scan_to_map\"\n[[robots.slam]]\ntype = \"rbpf\"\nresolution = 0.0\n"
+    ))
+    .unwrap_err();
+    same_error(&two, &file, "robots[0].slam[1].resolution");
+}
