@@ -44,4 +44,4 @@ pub use run::{
     Command, Controller, Finished, Observation, RunOptions, RunOutput, SimError, Simulation,
     SimulationBuilder, run_scenario, run_scenario_exporting,
 };
-pub use scenario::{Scenario, load_scenario, parse_scenario};
+pub use scenario::{RobotConfig, Scenario, load_scenario, parse_scenario};

@@ -5,5 +5,5 @@ pub use crate::run::{
     Command, Controller, Estimate, Finished, LocalizerView, NavigationView, Observation, RobotView,
     ScanView, SimError, Simulation, SimulationBuilder, Target, Twist,
 };
-pub use crate::scenario::Scenario;
+pub use crate::scenario::{RobotBuilder, RobotConfig, Scenario, ScenarioBuilder};
 pub use systems::prelude::*;

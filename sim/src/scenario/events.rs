@@ -9,9 +9,12 @@ use serde::Deserialize;
 use systems::core::Pose2;
 use systems::world::OccupancyGrid;
 
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+/// An event's `type`. Required in a file; the `Default` (waypoints) only lets a table be
+/// written with `..Default::default()`.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum EventType {
+    #[default]
     Waypoints,
     #[serde(alias = "kidnap")]
     Teleport,
@@ -22,7 +25,8 @@ pub enum EventType {
     Tasks,
 }
 
-#[derive(Deserialize, Debug)]
+/// One `[[events]]` table: the keys of its type (the others are errors).
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct EventFile {
     /// Simulated time (s).

@@ -8,12 +8,16 @@ use super::navigation::{NavigationFile, TaskFile};
 use super::outdoor::{RoadsFile, ZoneFile};
 use super::outdoor_robot::{CameraFile, CompassFile, GpsFile, RouteFile};
 use super::people::PersonFile;
+use super::places::{DoorFile, PlaceFile};
 use super::sensors::{EncoderFile, LaserFile};
 use super::slam::SlamList;
 use super::sonar::SonarFile;
 use serde::Deserialize;
+use std::collections::BTreeMap;
 
-#[derive(Deserialize, Debug, Default)]
+/// A scenario file as written: every key optional here, checked and defaulted by the resolver
+/// (`resolve`); the scenario builder fills one in code.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ScenarioFile {
     pub name: Option<String>,
@@ -24,6 +28,13 @@ pub struct ScenarioFile {
     /// End the run once every robot with tasks is done (default false: run `duration`).
     pub end_when_done: Option<bool>,
     pub map: Option<MapFile>,
+    /// Named places of the scenario itself (`[places.<name>]`, as in a places file), beside
+    /// those of `map.places`.
+    #[serde(default)]
+    pub places: BTreeMap<String, PlaceFile>,
+    /// Doors of the scenario itself (`[doors.<name>]`, as in a places file).
+    #[serde(default)]
+    pub doors: BTreeMap<String, DoorFile>,
     #[serde(default)]
     pub walls: Vec<WallFile>,
     #[serde(default)]
@@ -45,7 +56,8 @@ pub struct ScenarioFile {
     pub zones: Vec<ZoneFile>,
 }
 
-#[derive(Deserialize, Debug, Default)]
+/// `[map]`: the map file, the places file, or the cell size of a world of shapes.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct MapFile {
     /// ROS map_server YAML, relative to the scenario file.
@@ -56,7 +68,8 @@ pub struct MapFile {
     pub resolution: Option<f64>,
 }
 
-#[derive(Deserialize, Debug)]
+/// One of `walls`: a segment (thickness default 0.1 m).
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct WallFile {
     pub from: [f64; 2],
@@ -64,7 +77,8 @@ pub struct WallFile {
     pub thickness: Option<f64>,
 }
 
-#[derive(Deserialize, Debug)]
+/// One of `boxes`: a rectangle of `size` [length, width] turned by `yaw`.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct BoxFile {
     pub center: [f64; 2],
@@ -72,14 +86,16 @@ pub struct BoxFile {
     pub yaw: Option<f64>,
 }
 
-#[derive(Deserialize, Debug)]
+/// One of `discs`.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct DiscFile {
     pub center: [f64; 2],
     pub radius: f64,
 }
 
-#[derive(Deserialize, Debug, Default)]
+/// `[record]`: the recording's rates; those not given keep `RecordConfig::default()`.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RecordFile {
     /// Robot poses per second of simulated time.
@@ -98,7 +114,8 @@ pub struct RecordFile {
     pub camera_rate: Option<f64>,
 }
 
-#[derive(Deserialize, Debug)]
+/// One `[[robots]]` table.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RobotFile {
     pub name: String,
@@ -124,7 +141,8 @@ pub struct RobotFile {
     pub route: Option<RouteFile>,
 }
 
-#[derive(Deserialize, Debug)]
+/// A robot's `footprint`: exactly one of `circle` and `rectangle` (default: a 0.25 m circle).
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct FootprintFile {
     /// Radius of a round robot (m).
@@ -133,14 +151,19 @@ pub struct FootprintFile {
     pub rectangle: Option<[f64; 2]>,
 }
 
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+/// A drive's `type`. Required in a file; the `Default` (diff_drive) only lets a table be
+/// written with `..Default::default()`.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum KinematicsType {
+    #[default]
     DiffDrive,
     Ackermann,
 }
 
-#[derive(Deserialize, Debug)]
+/// A robot's `kinematics`: the drive's type and the parameters of that type (the others are
+/// errors); those not given take their defaults.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct KinematicsFile {
     #[serde(rename = "type")]
@@ -158,15 +181,19 @@ pub struct KinematicsFile {
     pub max_accel: Option<f64>,
 }
 
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+/// A behaviour's `type`. Required in a file; the `Default` is idle.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum BehaviourType {
+    #[default]
     Idle,
     Waypoints,
     Wander,
 }
 
-#[derive(Deserialize, Debug)]
+/// A robot's `behaviour`: idle, wander, or waypoints (`points`, `loop`), with its `speed`
+/// and waypoint `tolerance`.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct BehaviourFile {
     #[serde(rename = "type")]
@@ -178,7 +205,8 @@ pub struct BehaviourFile {
     pub tolerance: Option<f64>,
 }
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors]`: each sensor the robot has, each over its preset.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SensorsFile {
     pub laser: Option<LaserFile>,

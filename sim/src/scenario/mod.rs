@@ -2,7 +2,12 @@
 //! places), robots (kinematics, footprint, start pose, sensors from presets with overrides, a
 //! driving behaviour), recording rates and timed events. Unknown keys and out-of-range values are
 //! errors naming the file, line and key. The format is documented in `sim/docs/scenario-format.md`.
+//!
+//! A scenario can also be built in code ([`Scenario::builder`], [`RobotConfig::builder`]): the
+//! builders fill in the same file model ([`ScenarioFile`] and its tables, re-exported here) and
+//! go through the same resolver, so defaults and errors are the file's.
 
+pub mod builder;
 pub mod check;
 pub mod error;
 pub mod events;
@@ -23,13 +28,28 @@ pub mod slam_file;
 pub mod sonar;
 pub mod source;
 
+pub use builder::{CODE_LABEL, RobotBuilder, ScenarioBuilder};
+pub use check::PointOrPlace;
 pub use error::ScenarioError;
+pub use events::{EventFile, EventType};
+pub use file::{
+    BehaviourFile, BehaviourType, BoxFile, DiscFile, FootprintFile, KinematicsFile, KinematicsType,
+    MapFile, RecordFile, RobotFile, ScenarioFile, SensorsFile, WallFile,
+};
 pub use load::{
     DEFAULT_SCENARIO, assets_dir, bundled_scenarios, find_scenario, load_scenario, parse_scenario,
     scenario_arg, scenario_path,
 };
-pub use localizers::{LocalizerConfig, LocalizerKind};
+pub use localizers::{
+    InitType, LaserModelType, LocalizerConfig, LocalizerFile, LocalizerKind, LocalizerType,
+    MatcherType, MetricType,
+};
 pub use model::{DoorConfig, Event, EventAction, RecordConfig, RobotConfig, Scenario, SensorName};
-pub use navigation::NavConfig;
-pub use people::PersonConfig;
-pub use sonar::SonarConfig;
+pub use navigation::{NavConfig, NavigationFile, TaskFile, TaskType};
+pub use outdoor::{CircleFile, RoadsFile, ZoneFile};
+pub use outdoor_robot::{CameraFile, CompassFile, GpsFile, RouteFile};
+pub use people::{PersonConfig, PersonFile};
+pub use places::{DoorFile, PlaceFile};
+pub use sensors::{EncoderFile, LaserFile};
+pub use slam::{MatcherKind, SlamFile, SlamType};
+pub use sonar::{SonarConfig, SonarFile};

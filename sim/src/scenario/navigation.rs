@@ -13,7 +13,8 @@ use systems::navigation::{
     CostmapParams, FollowerParams, Goal, NavParams, PlannerParams, Steering, Task, TaskKind,
 };
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.navigation]`: planner, follower and stop-and-wait settings of a robot with tasks.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct NavigationFile {
     /// Name of the localizer to navigate by (default: wheel odometry).
@@ -32,15 +33,19 @@ pub struct NavigationFile {
     pub priority: Option<u32>,
 }
 
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+/// A task's `type`. Required in a file; the `Default` (delivery) only lets a table be written
+/// with `..Default::default()`.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum TaskType {
+    #[default]
     Delivery,
     Go,
     Wait,
 }
 
-#[derive(Deserialize, Debug)]
+/// One `[[robots.tasks]]` table.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct TaskFile {
     #[serde(rename = "type")]

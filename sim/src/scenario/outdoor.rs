@@ -13,7 +13,7 @@ use systems::world::roads::{GeoPoint, RoadGraph, RoadOptions, load_roads};
 use systems::world::zones::{Zone, ZoneKind, ZoneShape};
 
 /// `[roads]` as written.
-#[derive(Deserialize, Debug)]
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RoadsFile {
     /// OSM XML or GPX 1.1, relative to the scenario file.
@@ -29,7 +29,7 @@ pub struct RoadsFile {
 }
 
 /// One `[[zones]]` table as written.
-#[derive(Deserialize, Debug)]
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ZoneFile {
     pub name: String,
@@ -50,7 +50,8 @@ pub struct ZoneFile {
     pub compass_anticlockwise: Option<bool>,
 }
 
-#[derive(Deserialize, Debug)]
+/// A zone's `circle`.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct CircleFile {
     pub center: [f64; 2],

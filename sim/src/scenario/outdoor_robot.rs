@@ -14,7 +14,8 @@ use systems::sensors::gps::{COLD_START_S, HOT_START_S};
 use systems::sensors::{CameraSpec, CompassSpec, EncoderSpec, GpsSpec};
 use systems::world::roads::{NodeId, RoadGraph, geo::heading_of_azimuth};
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors.gps]` as written.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct GpsFile {
     /// Fixes per second (1–10 Hz).
@@ -26,7 +27,8 @@ pub struct GpsFile {
     pub altitude: Option<f64>,
 }
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors.compass]` as written.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct CompassFile {
     pub rate: Option<f64>,
@@ -34,7 +36,8 @@ pub struct CompassFile {
     pub bias_deg: Option<f64>,
 }
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors.camera]` as written.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct CameraFile {
     pub width: Option<u32>,
@@ -54,7 +57,7 @@ pub struct CameraFile {
 }
 
 /// `[robots.route]` as written.
-#[derive(Deserialize, Debug)]
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RouteFile {
     /// The road node the robot starts at (its id in the road file: the OSM node id).

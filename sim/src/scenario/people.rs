@@ -16,7 +16,7 @@ const MAX_SPEED: f64 = 3.0;
 const MAX_RADIUS: f64 = 1.0;
 
 /// One `[[people]]` table as written.
-#[derive(Deserialize, Debug)]
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct PersonFile {
     pub name: String,

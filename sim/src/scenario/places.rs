@@ -1,6 +1,7 @@
 //! The places file beside a map (the ROS map YAML has no room for them): named poses
 //! (`[places.<name>] pose = [x, y, yaw]`) and doors (`[doors.<name>] from, to, thickness`), with
-//! errors naming the places file and key.
+//! errors naming the places file and key. The scenario may carry the same tables itself (a
+//! scenario built in code puts its places there); they join the file's.
 
 use super::check::{Checker, R};
 use super::error::{ErrorContext, KeyPath};
@@ -12,7 +13,7 @@ use systems::core::Pose2;
 use systems::world::OccupancyGrid;
 
 /// Named places next to a map: `[places.<name>] pose = [x, y, yaw]`.
-#[derive(Deserialize, Debug, Default)]
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct PlacesFile {
     #[serde(default)]
@@ -22,7 +23,8 @@ pub struct PlacesFile {
     pub doors: std::collections::BTreeMap<String, DoorFile>,
 }
 
-#[derive(Deserialize, Debug)]
+/// A door: a wall segment, open in the map, that `door` events close and open.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct DoorFile {
     pub from: [f64; 2],
@@ -30,7 +32,8 @@ pub struct DoorFile {
     pub thickness: Option<f64>,
 }
 
-#[derive(Deserialize, Debug)]
+/// A named pose.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct PlaceFile {
     pub pose: [f64; 3],
@@ -45,25 +48,44 @@ pub(super) fn load_places(
     ppath: &Path,
     grid: &OccupancyGrid,
 ) -> R<(BTreeMap<String, Pose2>, Vec<DoorConfig>)> {
-    let mut places = BTreeMap::new();
-    let mut doors = Vec::new();
     let ptext = std::fs::read_to_string(ppath).map_err(|e| {
         c.cx.at(key, format!("cannot read {}: {e}", ppath.display()))
     })?;
     let pcx = ErrorContext::new(ppath.display().to_string(), &ptext);
     let parsed: PlacesFile = toml::from_str(&ptext).map_err(|e| pcx.from_toml(&e))?;
-    for (name, place) in parsed.places {
-        let pp = KeyPath::default().key("places").key(&name).key("pose");
+    let mut places = BTreeMap::new();
+    let mut doors = Vec::new();
+    add_places(&pcx, &parsed, grid, &mut places, &mut doors)?;
+    Ok((places, doors))
+}
+
+/// Checks the places and doors of `table` (a places file, or the scenario's own `[places]` and
+/// `[doors]`, whose errors `cx` names) and adds them; a name already taken is an error.
+pub(super) fn add_places(
+    cx: &ErrorContext,
+    table: &PlacesFile,
+    grid: &OccupancyGrid,
+    places: &mut BTreeMap<String, Pose2>,
+    doors: &mut Vec<DoorConfig>,
+) -> R<()> {
+    for (name, place) in &table.places {
+        let pp = KeyPath::default().key("places").key(name);
+        if places.contains_key(name) {
+            return Err(cx.at(&pp, format!("place `{name}` is also in the places file")));
+        }
         if place.pose.iter().any(|v| !v.is_finite()) {
-            return Err(pcx.at(&pp, "expected [x, y, yaw] finite numbers"));
+            return Err(cx.at(&pp.key("pose"), "expected [x, y, yaw] finite numbers"));
         }
         places.insert(
-            name,
+            name.clone(),
             Pose2::new(place.pose[0], place.pose[1], place.pose[2]),
         );
     }
-    for (name, d) in parsed.doors {
-        let dp = KeyPath::default().key("doors").key(&name);
+    for (name, d) in &table.doors {
+        let dp = KeyPath::default().key("doors").key(name);
+        if doors.iter().any(|o| &o.name == name) {
+            return Err(cx.at(&dp, format!("door `{name}` is also in the places file")));
+        }
         let b = grid.bounds();
         for (key, v) in [("from", d.from), ("to", d.to)] {
             if v.iter().any(|x| !x.is_finite())
@@ -72,7 +94,7 @@ pub(super) fn load_places(
                 || v[0] > b[2]
                 || v[1] > b[3]
             {
-                return Err(pcx.at(
+                return Err(cx.at(
                     &dp.key(key),
                     format!("expected a finite [x, y] inside the map, got {v:?}"),
                 ));
@@ -80,17 +102,17 @@ pub(super) fn load_places(
         }
         let thickness = d.thickness.unwrap_or(0.15);
         if !(thickness > 0.0 && thickness <= 2.0) {
-            return Err(pcx.at(
+            return Err(cx.at(
                 &dp.key("thickness"),
                 format!("expected a number in (0, 2] m, got {thickness}"),
             ));
         }
         doors.push(DoorConfig {
-            name,
+            name: name.clone(),
             from: d.from,
             to: d.to,
             thickness,
         });
     }
-    Ok((places, doors))
+    Ok(())
 }

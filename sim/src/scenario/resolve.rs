@@ -19,41 +19,66 @@ use systems::sensors::{CameraSpec, CompassSpec, EncoderSpec, GpsSpec, LaserSpec}
 use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
 use systems::world::{Cell, OccupancyGrid, load_map};
 
+/// Scenario text: parsed into its [`ScenarioFile`] and resolved; errors name `file_label`, the
+/// line and the key.
 pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str) -> R<Scenario> {
     let c = Checker {
         cx: ErrorContext::new(file_label.to_string(), text),
     };
     let f: ScenarioFile = toml::from_str(text).map_err(|e| c.cx.from_toml(&e))?;
+    resolve_file(&c, f, base_dir, default_name)
+}
+
+/// A scenario given as its file model (built in code by the scenario builder): the same checks
+/// and defaults as its text would get; errors name `label` and the key (there are no lines).
+pub fn resolve_model(
+    f: ScenarioFile,
+    label: &str,
+    base_dir: &Path,
+    default_name: &str,
+) -> R<Scenario> {
+    let c = Checker {
+        cx: ErrorContext::new(label.to_string(), ""),
+    };
+    resolve_file(&c, f, base_dir, default_name)
+}
+
+fn resolve_file(c: &Checker, f: ScenarioFile, base_dir: &Path, default_name: &str) -> R<Scenario> {
     let root = KeyPath::default();
-    let header = resolve_header(&c, &root, &f, default_name)?;
-    let shapes = resolve_shapes(&c, &root, &f)?;
+    let header = resolve_header(c, &root, &f, default_name)?;
+    let shapes = resolve_shapes(c, &root, &f)?;
     let roads = match &f.roads {
         Some(r) => Some(super::outdoor::resolve_roads(
-            &c,
+            c,
             &root.key("roads"),
             r,
             base_dir,
         )?),
         None => None,
     };
-    let zones = super::outdoor::resolve_zones(&c, &root.key("zones"), &f.zones)?;
+    let zones = super::outdoor::resolve_zones(c, &root.key("zones"), &f.zones)?;
     let map = f.map.as_ref();
-    let grid = resolve_grid(&c, &root, map, &shapes, roads.as_ref(), base_dir)?;
-    let (places, doors) = match map.and_then(|m| m.places.as_ref()) {
+    let grid = resolve_grid(c, &root, map, &shapes, roads.as_ref(), base_dir)?;
+    let (mut places, mut doors) = match map.and_then(|m| m.places.as_ref()) {
         Some(pf) => super::places::load_places(
-            &c,
+            c,
             &root.key("map").key("places"),
             &base_dir.join(pf),
             &grid,
         )?,
         None => (BTreeMap::new(), Vec::new()),
     };
+    let own = super::places::PlacesFile {
+        places: f.places.clone(),
+        doors: f.doors.clone(),
+    };
+    super::places::add_places(&c.cx, &own, &grid, &mut places, &mut doors)?;
     let world = World {
-        c: &c,
+        c,
         grid: &grid,
         places: &places,
     };
-    let record = resolve_record(&c, &root.key("record"), f.record.as_ref())?;
+    let record = resolve_record(c, &root.key("record"), f.record.as_ref())?;
     let mut robots: Vec<RobotConfig> = Vec::new();
     for (i, r) in f.robots.iter().enumerate() {
         let robot = resolve_robot(
@@ -67,7 +92,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         robots.push(robot);
     }
     let events = super::events::resolve_events(
-        &c,
+        c,
         &root.key("events"),
         &f.events,
         header.duration,
@@ -81,7 +106,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         &|p, v| world.points(p, v),
     )?;
     let people = super::people::resolve_people(
-        &c,
+        c,
         &root.key("people"),
         &f.people,
         &|p, v| world.point(p, v),
@@ -94,7 +119,7 @@ pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str
         seed: header.seed,
         dt: header.dt,
         duration: header.duration,
-        source: file_label.to_string(),
+        source: c.cx.file.clone(),
         grid,
         places,
         record,

@@ -7,7 +7,8 @@ use serde::Deserialize;
 use systems::core::Pose2;
 use systems::sensors::{EncoderSpec, LaserSpec};
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors.laser]`: a preset (default `sick_lms100`) and the values that override it.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct LaserFile {
     pub preset: Option<String>,
@@ -22,7 +23,8 @@ pub struct LaserFile {
     pub mount: Option<[f64; 3]>,
 }
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors.encoder]`: wheel encoders; the values not given are the defaults.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct EncoderFile {
     pub ticks_per_rev: Option<u32>,

@@ -12,7 +12,8 @@ use systems::mapping::rbpf::proposal::SampleGrid;
 use systems::mapping::scan_to_map::OdometryPriorModel;
 use systems::mapping::{GraphSlamConfig, RbpfConfig, ScanToMapConfig};
 
-#[derive(Debug)]
+/// A robot's `slam` key: one table or a list of them.
+#[derive(Debug, Clone)]
 pub enum SlamList {
     One(Box<SlamFile>),
     Many(Vec<SlamFile>),
@@ -53,9 +54,11 @@ impl SlamList {
     }
 }
 
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+/// A SLAM system's `type`. Required in a file; the `Default` is scan_to_map.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum SlamType {
+    #[default]
     ScanToMap,
     Graph,
     Rbpf,
@@ -71,7 +74,8 @@ impl SlamType {
     }
 }
 
-#[derive(Deserialize, Debug)]
+/// One SLAM system as written: the type and the parameters it reads.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SlamFile {
     #[serde(rename = "type")]
@@ -108,6 +112,7 @@ pub struct SlamFile {
     pub matcher: Option<MatcherKind>,
 }
 
+/// The scan matcher of `scan_to_map` (`matcher`).
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(rename_all = "snake_case")]
 pub enum MatcherKind {

@@ -13,7 +13,8 @@ use systems::core::Pose2;
 use systems::sensors::SonarSpec;
 use systems::sensors::sonar::edge_mounts;
 
-#[derive(Deserialize, Debug, Default)]
+/// `[robots.sensors.sonar]` as written.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SonarFile {
     pub preset: Option<String>,

@@ -20,9 +20,12 @@ use systems::localization::markov_grid::MarkovGridConfig;
 use systems::localization::mcl::{InitialBelief, LaserModel, LaserModelParams, MclConfig};
 use systems::matching::{DeParams, MatchConfig, SearchWindow, ThesisFitness};
 
-#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+/// A localizer's `type`. Required in a file; the `Default` (mcl) only lets a table be written
+/// with `..Default::default()`.
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 #[serde(rename_all = "snake_case")]
 pub enum LocalizerType {
+    #[default]
     Mcl,
     MarkovGrid,
     DeFilter,
@@ -163,6 +166,7 @@ impl LocalizerType {
     }
 }
 
+/// How a DE localizer compares scans (`metric`).
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(rename_all = "snake_case")]
 pub enum MetricType {
@@ -170,6 +174,7 @@ pub enum MetricType {
     L2,
 }
 
+/// The scan matcher of `de_odometry` (`matcher`).
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(rename_all = "snake_case")]
 pub enum MatcherType {
@@ -178,6 +183,7 @@ pub enum MatcherType {
     Euclidean,
 }
 
+/// MCL's laser model (`model`).
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(rename_all = "snake_case")]
 pub enum LaserModelType {
@@ -185,6 +191,7 @@ pub enum LaserModelType {
     Beam,
 }
 
+/// A localizer's initial belief (`init`).
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(rename_all = "snake_case")]
 pub enum InitType {
@@ -194,7 +201,9 @@ pub enum InitType {
     Pose,
 }
 
-#[derive(Deserialize, Debug)]
+/// One `[[robots.localization]]` table: the type and the parameters that type reads (the others
+/// are errors); those not given take the type's defaults.
+#[derive(Deserialize, Debug, Clone, Default)]
 #[serde(deny_unknown_fields)]
 pub struct LocalizerFile {
     #[serde(rename = "type")]
