@@ -7,6 +7,8 @@ use std::path::PathBuf;
 /// The most runs `--jobs` may ask for at the same time.
 pub const MAX_WORKERS: u64 = 1024;
 
+// the field docs are the --help text: <placeholders> are not HTML
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(clap::Args, Clone, Debug)]
 pub struct BatchArgs {
     /// A scenario file or the name of a bundled scenario.

@@ -34,6 +34,10 @@ pub struct SwarmOptions {
     /// Worker threads (0 = one per core; at most 1024).
     #[arg(long, default_value_t = 0, value_parser = crate::options::parse_threads)]
     pub threads: usize,
+    /// Step the world's schedule directly instead of through the library facade
+    /// (`sim::Simulation`, which `sim run` uses): measures what the facade costs.
+    #[arg(long)]
+    pub direct: bool,
 }
 
 #[derive(Serialize)]
@@ -46,6 +50,8 @@ struct SwarmResult {
     laser_rate_hz: f64,
     dt_s: f64,
     threads: usize,
+    /// "facade" (as `sim run`) or "schedule" (`--direct`).
+    stepped_by: &'static str,
     sim_time_s: f64,
     wall_time_s: f64,
     real_time_factor: f64,
@@ -82,7 +88,7 @@ const SPACING: f64 = 1.5;
 const MAX_MISSES: usize = 100_000;
 
 /// A swarm scenario: `n` wandering robots at random free places of `grid`, at least
-/// [`SPACING`] apart; an error if they do not fit.
+/// `SPACING` apart; an error if they do not fit.
 pub fn swarm_scenario(
     grid: &OccupancyGrid,
     n: usize,
@@ -218,17 +224,21 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     }
     for (beams, sc) in runs {
         let spec = swarm_laser(beams);
-        let out = run_scenario(
-            &sc,
-            &RunOptions {
-                rrd: None,
-                threads: o.threads,
-                progress: false,
-                trajectory_period: None,
-            },
-        )?;
-        let s = &out.summary;
-        let scans_per_robot = (s.sim_time_s * spec.rate + 1e-9).floor() + 1.0;
+        let (sim_time_s, wall_time_s) = if o.direct {
+            run_direct(&sc, o.threads)?
+        } else {
+            let out = run_scenario(
+                &sc,
+                &RunOptions {
+                    rrd: None,
+                    threads: o.threads,
+                    progress: false,
+                    trajectory_period: None,
+                },
+            )?;
+            (out.summary.sim_time_s, out.summary.wall_time_s)
+        };
+        let scans_per_robot = (sim_time_s * spec.rate + 1e-9).floor() + 1.0;
         let rays = sc.robots.len() as f64 * scans_per_robot * spec.beams() as f64;
         let threads = if o.threads == 0 {
             std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -244,10 +254,11 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
             laser_rate_hz: spec.rate,
             dt_s: sc.dt,
             threads,
-            sim_time_s: s.sim_time_s,
-            wall_time_s: s.wall_time_s,
-            real_time_factor: s.real_time_factor,
-            rays_per_s: rays / s.wall_time_s.max(1e-9),
+            stepped_by: if o.direct { "schedule" } else { "facade" },
+            sim_time_s,
+            wall_time_s,
+            real_time_factor: sim_time_s / wall_time_s.max(1e-9),
+            rays_per_s: rays / wall_time_s.max(1e-9),
             map: map.clone(),
         };
         if o.json {
@@ -260,6 +271,18 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// The scenario's ticks stepped on the bare schedule, timed from the first tick to the last as
+/// the facade's summary times them: (simulated s, wall s).
+fn run_direct(sc: &Scenario, threads: usize) -> anyhow::Result<(f64, f64)> {
+    let mut world = crate::build::build_world(sc, threads)?;
+    let ticks = (sc.duration / sc.dt).round().max(1.0) as u64;
+    let started = std::time::Instant::now();
+    for _ in 0..ticks {
+        world.step();
+    }
+    Ok((ticks as f64 * sc.dt, started.elapsed().as_secs_f64()))
 }
 
 #[cfg(test)]

@@ -1,5 +1,5 @@
 //! `--save-map PATH`: maps exported as ROS map_server YAML + PGM
-//! ([`systems::world::save_map`], trinary, occupied_thresh 0.65, free_thresh 0.196).
+//! (`systems::world::save_map`, trinary, occupied_thresh 0.65, free_thresh 0.196).
 //!
 //! `sim run` saves every SLAM system's final map, and for each robot with a laser but no SLAM a
 //! map built with known poses: log-odds occupancy mapping ([`LogOddsMap`], Probabilistic

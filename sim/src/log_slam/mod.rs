@@ -30,6 +30,8 @@ use report::{MapInfo, SlamReport};
 use std::path::{Path, PathBuf};
 use systems::core::{KernelPool, Pose2, stream_rng};
 
+// the field docs are the --help text: <placeholders> are not HTML
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(clap::Args, Clone, Debug)]
 pub struct SlamArgs {
     /// The CARMEN log (plain text).

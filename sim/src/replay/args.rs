@@ -3,6 +3,8 @@
 use crate::run::report::OutputArgs;
 use std::path::PathBuf;
 
+// the field docs are the --help text: <placeholders> are not HTML
+#[allow(rustdoc::invalid_html_tags)]
 #[derive(clap::Args, Clone, Debug)]
 pub struct ReplayArgs {
     /// An MCAP file: written by `sim run --mcap`, or by another ROS 2 system (then give

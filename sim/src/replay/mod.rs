@@ -3,8 +3,8 @@
 //!
 //! The world is built from the scenario as for a live run, with only the estimators' and the
 //! evaluation's systems ([`crate::build::BuildMode::Replay`]); a feed system in the Sense set
-//! ([`feed`]) hands each robot, tick by tick, the scans, encoder readings or odometry poses and
-//! true poses read from the file ([`source`]). Scenario events still fire (a door that closes
+//! (`feed`) hands each robot, tick by tick, the scans, encoder readings or odometry poses and
+//! true poses read from the file (`source`). Scenario events still fire (a door that closes
 //! changes the map the localizers believe in).
 //!
 //! Our own files (`sim run --mcap`) carry the scenario and the run's seed, tick and topic

@@ -7,8 +7,8 @@ use systems::core::{RobotId, RobotIndex};
 use systems::sensors::{LaserScans, LaserTruth};
 
 /// Laser scans to collect during a run, with the true sensor pose of each (SCANS files, scan
-/// matching experiments). Passed to [`run_scenario_capturing`]; a separate argument rather than
-/// a [`RunOptions`] field so existing `RunOptions { .. }` literals keep compiling.
+/// matching experiments). Passed to [`super::run_scenario_capturing`]; a separate argument rather than
+/// a [`super::RunOptions`] field so existing `RunOptions { .. }` literals keep compiling.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScanCapture {
     /// Keep one scan per robot every `period_s` seconds of simulated time: the first scan whose

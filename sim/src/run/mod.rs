@@ -1,4 +1,4 @@
-//! A run, in its phases ([`run_world`]): the outputs join the built world's schedule, the world
+//! A run, in its phases (`run_world`): the outputs join the built world's schedule, the world
 //! steps as fast as the CPU allows for the scenario's duration (with a progress bar), the
 //! estimators and recordings are finished, and the summary is read. A stop
 //! asked for by Ctrl-C or SIGTERM ([`crate::run::interrupt`]) ends the loop after the current tick;

@@ -6,6 +6,8 @@ use crate::formats::tum::write_trajectories;
 use crate::run::RunOptions;
 use std::path::{Path, PathBuf};
 
+// the field docs are the --help text: <placeholders> are not HTML
+#[allow(rustdoc::invalid_html_tags)]
 /// The outputs a run and a replay share.
 #[derive(clap::Args, Clone, Debug)]
 pub struct OutputArgs {

@@ -1,6 +1,6 @@
 //! [`Simulation`]: a scenario's world that a program loads, steps, reads and commands between
 //! ticks: the simulator as a library. `sim run`, `sim batch` and `sim replay` drive this same
-//! type ([`super::run_world`]), so a program gets their schedule, determinism, recordings and
+//! type (`run_world`), so a program gets their schedule, determinism, recordings and
 //! summary.
 //!
 //! ```no_run

@@ -1,6 +1,6 @@
 //! A SLAM system configured outside a scenario (`sim slam --slam TYPE --slam-config FILE`): the
 //! file holds the table of a robot's `slam` key, without the `slam =` around it, and goes
-//! through the scenario's own resolution ([`super::slam::resolve_slam`]), so every type the key
+//! through the scenario's own resolution (`resolve_slam`), so every type the key
 //! accepts is accepted here, with the same defaults, checks and error messages (file, line,
 //! key).
 

@@ -91,6 +91,28 @@ fn bench_swarm_prints_one_row_per_population_and_laser() {
     assert_eq!(asked(&commas), [(1, 30), (3, 30), (1, 45), (3, 45)]);
     let ran = |r: &serde_json::Value| (r["sim_time_s"].as_f64().unwrap() - 0.3).abs() < 1e-9;
     assert!(commas.iter().all(ran), "{commas:?}");
+    assert!(
+        commas.iter().all(|r| r["stepped_by"] == "facade"),
+        "{commas:?}"
+    );
+    // --direct steps the bare schedule for the same simulated time
+    let direct = bench_rows(
+        &[
+            "bench",
+            "swarm",
+            "--json",
+            "--robots",
+            "3",
+            "--beams",
+            "30",
+            "--duration",
+            "0.3",
+            "--direct",
+        ],
+        &fields,
+    );
+    assert!(direct.iter().all(ran), "{direct:?}");
+    assert_eq!(direct[0]["stepped_by"], "schedule");
 }
 
 /// Options the swarm benchmark cannot honour are refused before anything runs, naming the

@@ -11,7 +11,7 @@
 //! [`PATIENCE`] s without getting nearer its next point turns back to the point it came from,
 //! since whoever is in its way may be waiting for it in turn. People are part of the world, not
 //! robots: they read ground truth (everyone's [`TruePose`]) and carry no
-//! [`RobotIndex`](crate::core::RobotIndex), so robot-indexed code (collision counters,
+//! [`RobotIndex`], so robot-indexed code (collision counters,
 //! summaries) never sees them.
 
 use super::footprint::Footprint;
@@ -42,7 +42,7 @@ const SIDE_PROBE: f64 = 0.3;
 const SIDESTEP: f64 = 0.5;
 /// A route point is reached within this distance (m).
 pub const ARRIVE_TOL: f64 = 0.1;
-/// A person held up by someone in its way that has not come [`PROGRESS`] m nearer its next
+/// A person held up by someone in its way that has not come `PROGRESS` m nearer its next
 /// route point for this long (s) turns back to the point it came from: a robot may be waiting
 /// for it as it waits for the robot.
 pub const PATIENCE: f64 = 10.0;

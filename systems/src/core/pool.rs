@@ -68,7 +68,7 @@ impl KernelPool {
 
     /// Runs `f` inside the pool (rayon's parallel iterators in it use the pool's workers). Any
     /// worker still waiting from the previous section is released first, and afterwards some
-    /// wait for the next section (for [`STAY_AWAKE`] at most).
+    /// wait for the next section (for `STAY_AWAKE` at most).
     pub fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
         self.section.fetch_add(1, Ordering::AcqRel);
         let r = self.pool.install(f);

@@ -12,7 +12,7 @@
 //! rlog = fitness(x*) − fitness(x_i) for a cost to be minimised, which accepts the worse
 //! proposals; the Metropolis rule is what the cited paper means.) Between scans the chains move
 //! by odometry; the estimate is the best member (refined locally and moved without noise, as in
-//! [`super::de_filter`]); the filter is converged when the best cost has stayed low. The Kullback-Leibler-based sizing of the population in [20] is not
+//! [`super::de_filter`]); the filter is converged when the best cost has stayed low. The Kullback-Leibler-based sizing of the population in \[20\] is not
 //! implemented: the population is fixed.
 
 use super::de_population::{RangeMetric, range_costs, three_others};
@@ -47,7 +47,7 @@ pub struct DeMcConfig {
     /// stayed above twice that for as many.
     pub converge_cost: f64,
     pub converge_updates: u32,
-    /// Local refinement of the best member at each update ([`Population::refine_best`]):
+    /// Local refinement of the best member at each update (`Population::refine_best`):
     /// rounds, samples per round, initial spread (m, m, rad); 0 rounds disables it.
     pub refine_rounds: usize,
     pub refine_samples: usize,

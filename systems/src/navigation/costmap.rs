@@ -12,7 +12,7 @@
 //!
 //! Distances are centre to centre (as in ROS), from the exact Euclidean distance transform of
 //! Felzenszwalb & Huttenlocher (2012) that the localization distance field uses too
-//! ([`squared_distances`]), so inflation is isotropic rather than the chamfer approximation of
+//! (`squared_distances`), so inflation is isotropic rather than the chamfer approximation of
 //! a breadth-first wave. Cells outside the grid are not obstacles.
 
 use crate::world::distance_field::squared_distances;

@@ -49,8 +49,8 @@ impl Beams {
     }
 }
 
-/// Circles (cx, cy, radius): out[k] = min(out[k], distance to the circle along beam k). A sensor
-/// inside a circle sees 0 on every beam.
+/// Circles (cx, cy, radius): `out[k] = min(out[k], d)` with d the distance to the circle along
+/// beam k. A sensor inside a circle sees 0 on every beam.
 pub fn overlay_circles(
     p: [f32; 2],
     start: f32,
@@ -96,7 +96,8 @@ pub fn overlay_circles(
     }
 }
 
-/// Segments (x0, y0, x1, y1): out[k] = min(out[k], distance to the segment along beam k).
+/// Segments (x0, y0, x1, y1): `out[k] = min(out[k], d)` with d the distance to the segment
+/// along beam k.
 pub fn overlay_segments(
     p: [f32; 2],
     start: f32,

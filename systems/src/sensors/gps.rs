@@ -13,7 +13,7 @@
 //! The parameters come from the zone the robot is in ([`crate::world::Zones`]). No fix is
 //! reported before `first_fix` seconds (cold or hot start). Readings follow
 //! sensor_msgs/NavSatFix: latitude and longitude in degrees through the world's
-//! [`GeoFrame`](crate::world::roads::GeoFrame), altitude, status and a diagonal covariance.
+//! [`GeoFrame`], altitude, status and a diagonal covariance.
 
 use crate::body::TruePose;
 use crate::core::clock::RateTimer;
@@ -121,7 +121,7 @@ impl GpsErrorModel {
 }
 
 /// Expected squared error per horizontal axis (m²) of a zone: bias variance plus half the mean
-/// square of the log-normal length, E[d²] = exp(2μ + 2σ²).
+/// square of the log-normal length, `E[d²] = exp(2μ + 2σ²)`.
 pub fn expected_variance(zone: &GpsZone) -> f64 {
     zone.bias_std * zone.bias_std + 0.5 * (2.0 * zone.mu + 2.0 * zone.sigma * zone.sigma).exp()
 }

@@ -1,5 +1,5 @@
 //! Sensors: each is a component holding its parameters, its own random stream and rate timer, and
-//! a sampling system in [`SimSet::Sense`](crate::core::SimSet::Sense) that reads ground truth and
+//! a sampling system in [`SimSet::Sense`] that reads ground truth and
 //! writes readings shaped like the ROS messages they are recorded as.
 
 pub mod camera;

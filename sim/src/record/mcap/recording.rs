@@ -1,5 +1,5 @@
 //! What an MCAP file holds once read: its channels, messages and attachments (filled by the
-//! linear pass in [`super::scan`], opened and decoded through [`super::reader`]).
+//! linear pass in `super::scan`, opened and decoded through [`super::reader`]).
 
 use std::path::PathBuf;
 

@@ -125,7 +125,7 @@ pub fn joint_state(
     }
 }
 
-/// The tick count of a wheel angle written by [`joint_state`].
+/// The tick count of a wheel angle written by `joint_state`.
 pub fn ticks_of_angle(angle: f64, ticks_per_rev: u32) -> i64 {
     (angle / (TAU / ticks_per_rev as f64)).round() as i64
 }

@@ -20,7 +20,7 @@
 //!   are removed as false matches and the graph optimized again. The local SLAM keeps running in
 //!   its own frame; published poses are its poses carried into the global frame through the
 //!   latest node.
-//! * The map (`map()`) is rebuilt from every node's scan at its optimized pose ([`global_map`]).
+//! * The map (`map()`) is rebuilt from every node's scan at its optimized pose (`global_map`).
 
 mod global_map;
 pub mod loop_closure;

@@ -29,7 +29,7 @@
 //!   `F(r4 − r5)`.
 //! * eq. 27 switches on `rnd < F`; `p_F` defaults to `F` as printed ([`DeParams::either_or_probability`]
 //!   = `None`), Price's original uses a separate probability, which can be set.
-//! * crossover: §5.1 (after Zelinka [12]) takes the mutant's component when `rnd < CR`; §6's prose
+//! * crossover: §5.1 (after Zelinka \[12\]) takes the mutant's component when `rnd < CR`; §6's prose
 //!   says the opposite ("if the number is higher than CR the components are swapped"). We follow
 //!   §5.1 and Storn & Price: binomial takes `uⱼ` when `rnd < CR` or `j = j_rand` (so at least one
 //!   component comes from the mutant); exponential copies a run of components starting at a

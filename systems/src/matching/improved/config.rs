@@ -53,7 +53,7 @@ pub struct ImprovedConfig {
     /// (0 counts every point).
     pub blob_extent: f32,
     /// Free-standing compact objects (people, robots) are dropped from both scans before
-    /// matching ([`crate::matching::movable`]): runs of points spanning less than
+    /// matching (`matching::movable`): runs of points spanning less than
     /// `movable_extent` (m; 0 keeps every point) that stand at least `movable_jump` (m) in front
     /// of the points beside them.
     pub movable_extent: f32,

@@ -24,7 +24,7 @@ impl RoadRecognizer {
 
     /// Learns a road of another surface from the next `frames` frames whose learning window
     /// shows a road (mostly colours that are not background), looking for them over
-    /// at most [`RELEARN_BUDGET`] frames. The road already learned stays recognized meanwhile.
+    /// at most `RELEARN_BUDGET` frames. The road already learned stays recognized meanwhile.
     pub fn relearn(&mut self, frames: u32) {
         self.relearn_frames = frames;
         self.relearn_budget = RELEARN_BUDGET;

@@ -15,7 +15,7 @@ pub const DEFAULT_FLUSH_PERIOD_NS: u64 = 10_000_000_000;
 pub(crate) trait Output: std::io::Write + std::io::Seek + Send {}
 impl<T: std::io::Write + std::io::Seek + Send> Output for T {}
 
-/// What [`McapRecorder::finish`] wrote.
+/// What `McapRecorder::finish` wrote.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct McapStats {
     pub messages: u64,

@@ -14,7 +14,7 @@
 //! An entity's rows go out as one chunk when they reach [`CHUNK_ROWS`] rows or [`CHUNK_BYTES`]
 //! of data or span [`CHUNK_SPAN_S`] of simulated time (so that little is left to build when
 //! the run ends), and every entity's when the recording is flushed ([`RrdStream::flush_blocking`],
-//! done by [`super::close_recording`] at the end of a run, also an interrupted one). A full
+//! done by `close_recording` at the end of a run, also an interrupted one). A full
 //! set of columns goes to a thread of the stream that serializes them, builds the chunk and
 //! hands it to the SDK, then sends the emptied columns back: the entity's next rows fill them,
 //! so a column does not grow again from nothing (copying itself over and over, on fresh
