@@ -6,4 +6,5 @@ pub use crate::run::{
     ScanView, SimError, Simulation, SimulationBuilder, Target, Twist,
 };
 pub use crate::scenario::{RobotBuilder, RobotConfig, Scenario, ScenarioBuilder};
+pub use systems::body::Collisions;
 pub use systems::prelude::*;

@@ -14,8 +14,10 @@ pub mod merge;
 pub mod output;
 pub mod runner;
 pub mod sets;
+pub mod sweep;
 
 pub use args::BatchArgs;
+pub use sweep::Sweep;
 
 use crate::options::check_duration;
 use crate::run::summary::Summary;
@@ -254,6 +256,61 @@ pub fn rows(b: &Batch, done: &[runner::Finished<Summary>]) -> Vec<Row> {
         .collect()
 }
 
+/// A batch's runs and their statistics, before any file is written: what `sim batch` writes and
+/// prints, and what [`Sweep::run`] returns.
+pub struct BatchResults {
+    /// Every run's summary (or error), in job order.
+    pub runs: Vec<runner::Finished<Summary>>,
+    /// One row per run, in job order (as in runs.csv).
+    pub rows: Vec<Row>,
+    /// The runs.csv header.
+    pub columns: Vec<String>,
+    /// Per parameter set, the statistics of every metric (as in aggregate.csv).
+    pub stats: Vec<aggregate::SetStats>,
+    /// The aggregate table `sim batch` prints.
+    pub table: String,
+    /// Runs that failed.
+    pub failed: usize,
+}
+
+impl Batch {
+    /// Runs the jobs on `workers` parallel runs of `threads` kernel threads each (recordings
+    /// into `rrd_dir` if given) and computes the rows and statistics: the engine of `sim batch`
+    /// and of [`Sweep`].
+    pub fn execute(
+        &self,
+        workers: usize,
+        threads: usize,
+        rrd_dir: Option<&Path>,
+        show_progress: bool,
+    ) -> anyhow::Result<BatchResults> {
+        let runs = run_batch(self, workers, threads, rrd_dir, show_progress)?;
+        let rows = rows(self, &runs);
+        let columns = if rows.is_empty() {
+            // a shard without jobs: the header of the run columns alone
+            let none = runner::Job {
+                index: 0,
+                set: 0,
+                seed: 0,
+            };
+            output::columns(&[output::run_columns(&none, &self.keys, &[], None, 0.0)])
+        } else {
+            output::columns(&rows)
+        };
+        let stats = aggregate::aggregate(self.sets.len(), &columns, &rows);
+        let table = aggregate::table(&stats);
+        let failed = runs.iter().filter(|f| f.result.is_err()).count();
+        Ok(BatchResults {
+            runs,
+            rows,
+            columns,
+            stats,
+            table,
+            failed,
+        })
+    }
+}
+
 /// `sim batch`.
 pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
     let started = Instant::now();
@@ -281,41 +338,31 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
         );
     }
     let rrd_dir = a.rrd.then_some(out_dir.as_path());
-    let done = run_batch(&b, a.jobs, a.threads, rrd_dir, !a.quiet)?;
-    let rows = rows(&b, &done);
-    let mut cols = output::columns(&rows);
-    if rows.is_empty() {
+    let r = b.execute(a.jobs, a.threads, rrd_dir, !a.quiet)?;
+    if r.rows.is_empty() {
         eprintln!("warning: this shard has no jobs (the batch has fewer than its number)");
-        let none = runner::Job {
-            index: 0,
-            set: 0,
-            seed: 0,
-        };
-        cols = output::columns(&[output::run_columns(&none, &b.keys, &[], None, 0.0)]);
     }
-    output::write_csv(&out_dir.join("runs.csv"), &cols, &rows)?;
-    output::write_jsonl(&out_dir.join("runs.jsonl"), &rows)?;
-    let stats = aggregate::aggregate(b.sets.len(), &cols, &rows);
-    aggregate::write_aggregate(&out_dir.join("aggregate.csv"), &stats)?;
+    output::write_csv(&out_dir.join("runs.csv"), &r.columns, &r.rows)?;
+    output::write_jsonl(&out_dir.join("runs.jsonl"), &r.rows)?;
+    aggregate::write_aggregate(&out_dir.join("aggregate.csv"), &r.stats)?;
     b.manifest.write(&out_dir)?;
-    let table = aggregate::table(&stats);
-    let failed = done.iter().filter(|f| f.result.is_err()).count();
     let wall_s = started.elapsed().as_secs_f64();
     if !a.quiet {
-        print!("{table}");
+        print!("{}", r.table);
         println!(
-            "{} runs, {failed} failed, in {wall_s:.1} s; runs.csv, runs.jsonl, aggregate.csv and \
+            "{} runs, {} failed, in {wall_s:.1} s; runs.csv, runs.jsonl, aggregate.csv and \
              batch.json written to {}",
-            done.len(),
+            r.runs.len(),
+            r.failed,
             out_dir.display()
         );
     }
     Ok(BatchReport {
         out_dir,
-        runs: done.len(),
-        failed,
-        rows,
-        table,
+        runs: r.runs.len(),
+        failed: r.failed,
+        rows: r.rows,
+        table: r.table,
         wall_s,
     })
 }
