@@ -338,17 +338,15 @@ pub fn new_filter(
     let need_map =
         || map.ok_or_else(|| anyhow::anyhow!("a localizer of this type needs the scenario's map"));
     Ok(match kind {
-        LocalizerKind::Mcl(c) => Filter::Mcl(Box::new(Mcl::new(c.clone(), need_map()?, rng))),
+        LocalizerKind::Mcl(c) => Filter::Map(Box::new(Mcl::new(c.clone(), need_map()?, rng))),
         LocalizerKind::MarkovGrid(c) => {
-            Filter::MarkovGrid(Box::new(MarkovGrid::new(c.clone(), need_map()?)))
+            Filter::Map(Box::new(MarkovGrid::new(c.clone(), need_map()?)))
         }
         LocalizerKind::DeFilter(c) => {
-            Filter::DeFilter(Box::new(DeFilter::new(c.clone(), need_map()?, rng)))
+            Filter::Map(Box::new(DeFilter::new(c.clone(), need_map()?, rng)))
         }
-        LocalizerKind::DeMc(c) => Filter::DeMc(Box::new(DeMc::new(c.clone(), need_map()?, rng))),
-        LocalizerKind::DeOdometry(c) => {
-            Filter::DeOdometry(Box::new(DeOdometry::new(c.clone(), rng)))
-        }
+        LocalizerKind::DeMc(c) => Filter::Map(Box::new(DeMc::new(c.clone(), need_map()?, rng))),
+        LocalizerKind::DeOdometry(c) => Filter::Map(Box::new(DeOdometry::new(c.clone(), rng))),
         LocalizerKind::ScanToMap(c) => {
             Filter::Scan(Box::new(ScanToMapSlam::new((**c).clone()).with_rng(rng)))
         }

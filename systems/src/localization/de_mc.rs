@@ -18,6 +18,7 @@
 use super::de_population::{RangeMetric, range_costs, three_others};
 use super::de_tracker::{CycleSettings, DeTracker};
 use super::map::LocalizationMap;
+use super::map_localizer::MapLocalizer;
 use super::mcl::{BeamSubset, InitialBelief, PoseEstimate};
 use super::motion_model::OdometryMotionModel;
 use crate::core::{Pose2, SimRng, wrap_angle};
@@ -102,30 +103,67 @@ impl DeMc {
 
     /// Consumes a scan taken at odometry pose `odom`. Returns true if the filter updated.
     pub fn update(&mut self, map: &LocalizationMap, beams: &BeamSubset, odom: &Pose2) -> bool {
+        MapLocalizer::predict(self, odom) && MapLocalizer::correct(self, map, beams)
+    }
+}
+
+impl DeMcConfig {
+    /// The settings of the cycle shared with the other DE localizer.
+    fn cycle(&self) -> CycleSettings<'_> {
+        CycleSettings {
+            motion: &self.motion,
+            update_min_d: self.update_min_d,
+            update_min_a: self.update_min_a,
+            metric: self.metric,
+            converge_cost: self.converge_cost,
+            converge_updates: self.converge_updates,
+            refine_rounds: self.refine_rounds,
+            refine_samples: self.refine_samples,
+            refine_sd: self.refine_sd,
+            reseed: self.population,
+        }
+    }
+}
+
+/// The shared cycle split in two ([`DeTracker::predict`], [`DeTracker::correct`]).
+impl MapLocalizer for DeMc {
+    fn kind(&self) -> &'static str {
+        "de_mc"
+    }
+
+    fn max_beams(&self) -> usize {
+        self.config.max_beams
+    }
+
+    fn predict(&mut self, odom: &Pose2) -> bool {
+        self.tracker.predict(odom, &self.config.cycle())
+    }
+
+    fn correct(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> bool {
         let c = &self.config;
-        let settings = CycleSettings {
-            motion: &c.motion,
-            update_min_d: c.update_min_d,
-            update_min_a: c.update_min_a,
-            metric: c.metric,
-            converge_cost: c.converge_cost,
-            converge_updates: c.converge_updates,
-            refine_rounds: c.refine_rounds,
-            refine_samples: c.refine_samples,
-            refine_sd: c.refine_sd,
-            reseed: c.population,
-        };
+        let settings = c.cycle();
         let acceptance = &mut self.acceptance;
-        self.tracker
-            .update(map, beams, odom, &settings, |t, converged| {
-                let iters = if converged {
-                    c.tracking_iterations
-                } else {
-                    c.iterations
-                };
-                let accepted: usize = (0..iters).map(|_| iterate(t, c, map, beams)).sum();
-                *acceptance = accepted as f64 / (iters * t.population.len()).max(1) as f64;
-            })
+        self.tracker.correct(map, beams, &settings, |t, converged| {
+            let iters = if converged {
+                c.tracking_iterations
+            } else {
+                c.iterations
+            };
+            let accepted: usize = (0..iters).map(|_| iterate(t, c, map, beams)).sum();
+            *acceptance = accepted as f64 / (iters * t.population.len()).max(1) as f64;
+        })
+    }
+
+    fn estimate(&self) -> Option<PoseEstimate> {
+        self.tracker.estimate
+    }
+
+    fn box_clone(&self) -> Box<dyn MapLocalizer> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 

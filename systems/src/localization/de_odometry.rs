@@ -10,7 +10,9 @@
 //! transform; its covariance grows by `step_sd²` per keyframe (a dead-reckoning estimate).
 //! It is a relative localizer: it starts from a given pose and never re-localizes.
 
-use super::mcl::PoseEstimate;
+use super::map::LocalizationMap;
+use super::map_localizer::MapLocalizer;
+use super::mcl::{BeamSubset, PoseEstimate};
 use crate::core::{Pose2, SimRng};
 use crate::matching::{MatchConfig, Method, SearchWindow, match_scans_with_rng};
 
@@ -57,6 +59,8 @@ struct Keyframe {
 pub struct DeOdometry {
     pub config: DeOdometryConfig,
     key: Option<Keyframe>,
+    /// The odometry pose of the scan about to be matched (set by a predict that accepted it).
+    pending: Option<Pose2>,
     variance: [f64; 3],
     rng: SimRng,
     /// Matches believed, and updates that fell back to the wheel odometry.
@@ -71,6 +75,7 @@ impl DeOdometry {
         DeOdometry {
             config,
             key: None,
+            pending: None,
             variance: [0.0; 3],
             rng,
             matches: 0,
@@ -83,20 +88,27 @@ impl DeOdometry {
     /// Consumes a scan's endpoints (base frame) taken at odometry pose `odom`. Returns true if
     /// the estimate was updated.
     pub fn update(&mut self, points: &[[f32; 2]], odom: &Pose2) -> bool {
+        MapLocalizer::predict(self, odom) && self.correct_points(points)
+    }
+
+    /// The scan half of [`DeOdometry::update`], at the odometry pose the last
+    /// [`MapLocalizer::predict`] accepted: the first scan becomes the keyframe at the start pose;
+    /// a later one is matched against the keyframe and becomes the next. Always true.
+    fn correct_points(&mut self, points: &[[f32; 2]]) -> bool {
+        let odom = self
+            .pending
+            .take()
+            .expect("correct follows a predict that returned true");
         let Some(key) = &self.key else {
             self.key = Some(Keyframe {
                 points: points.to_vec(),
-                odom: *odom,
+                odom,
                 pose: self.config.start,
             });
             self.publish(self.config.start);
             return true;
         };
-        let guess = key.odom.inverse().compose(odom);
-        let turned = crate::core::wrap_angle(guess.theta).abs();
-        if guess.x.hypot(guess.y) < self.config.update_min_d && turned < self.config.update_min_a {
-            return false;
-        }
+        let guess = key.odom.inverse().compose(&odom);
         let moved: Vec<[f32; 2]> = points
             .iter()
             .map(|p| {
@@ -122,7 +134,7 @@ impl DeOdometry {
         }
         self.key = Some(Keyframe {
             points: points.to_vec(),
-            odom: *odom,
+            odom,
             pose,
         });
         self.publish(pose);
@@ -147,11 +159,54 @@ impl DeOdometry {
     }
 }
 
+/// A dead-reckoning estimator has no motion update of a belief: `predict` only checks that the
+/// odometry has moved enough since the keyframe and remembers its pose; `correct` matches the
+/// scan ([`DeOdometry::update`] is the two together).
+impl MapLocalizer for DeOdometry {
+    fn kind(&self) -> &'static str {
+        "de_odometry"
+    }
+
+    fn max_beams(&self) -> usize {
+        self.config.max_beams
+    }
+
+    fn predict(&mut self, odom: &Pose2) -> bool {
+        if let Some(key) = &self.key {
+            let guess = key.odom.inverse().compose(odom);
+            let turned = crate::core::wrap_angle(guess.theta).abs();
+            if guess.x.hypot(guess.y) < self.config.update_min_d
+                && turned < self.config.update_min_a
+            {
+                return false;
+            }
+        }
+        self.pending = Some(*odom);
+        true
+    }
+
+    /// Reads the scan's returns only; the map is not used.
+    fn correct(&mut self, _map: &LocalizationMap, beams: &BeamSubset) -> bool {
+        self.correct_points(&beams.returns())
+    }
+
+    fn estimate(&self) -> Option<PoseEstimate> {
+        self.estimate
+    }
+
+    fn box_clone(&self) -> Box<dyn MapLocalizer> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::core::stream_rng;
-    use crate::localization::mcl::BeamSubset;
     use crate::localization::test_drive::{CORRIDOR, drive, error, hospital};
 
     /// Along the corridor drive (≈ 38 m, two right-angle turns) scan matching keeps the drift far

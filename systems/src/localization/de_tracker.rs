@@ -82,6 +82,13 @@ impl DeTracker {
         s: &CycleSettings,
         evolve: impl FnOnce(&mut DeTracker, bool),
     ) -> bool {
+        self.predict(odom, s) && self.correct(map, beams, s, evolve)
+    }
+
+    /// The motion half of [`DeTracker::update`]: false (nothing changed) unless this is the first
+    /// scan or the odometry has moved enough since the last update; otherwise the population
+    /// moves by the odometry since then.
+    pub fn predict(&mut self, odom: &Pose2, s: &CycleSettings) -> bool {
         if let Some(last) = self.last_odom {
             if !moved_enough(&last, odom, s.update_min_d, s.update_min_a) {
                 return false;
@@ -95,6 +102,18 @@ impl DeTracker {
                 .map(|t| t.compose(&last.inverse().compose(odom)));
         }
         self.last_odom = Some(*odom);
+        true
+    }
+
+    /// The scan half of [`DeTracker::update`], after a [`DeTracker::predict`] that returned true:
+    /// scoring, refinement, `evolve`, elite, convergence and estimate. Always true.
+    pub fn correct(
+        &mut self,
+        map: &LocalizationMap,
+        beams: &BeamSubset,
+        s: &CycleSettings,
+        evolve: impl FnOnce(&mut DeTracker, bool),
+    ) -> bool {
         if beams.is_empty() {
             return true;
         }

@@ -3,12 +3,9 @@
 //! compared on identical sensor data. Inputs are the robot's laser scans and its wheel-odometry
 //! estimate at each scan's time; nothing here reads ground truth.
 
-use super::de_filter::DeFilter;
-use super::de_mc::DeMc;
-use super::de_odometry::DeOdometry;
 use super::map::LocalizationMap;
-use super::markov_grid::MarkovGrid;
-use super::mcl::{BeamSubset, Mcl, PoseEstimate};
+use super::map_localizer::MapLocalizer;
+use super::mcl::{BeamSubset, PoseEstimate};
 use super::odometry::WheelOdometry;
 use super::scan_estimator::ScanEstimator;
 use crate::core::{KernelPool, Pose2};
@@ -18,11 +15,8 @@ use bevy_ecs::prelude::*;
 /// One localization algorithm with its state.
 #[derive(Clone, Debug)]
 pub enum Filter {
-    Mcl(Box<Mcl>),
-    MarkovGrid(Box<MarkovGrid>),
-    DeFilter(Box<DeFilter>),
-    DeMc(Box<DeMc>),
-    DeOdometry(Box<DeOdometry>),
+    /// A localizer on the map (ours or a user's), fed in the Estimate set.
+    Map(Box<dyn MapLocalizer>),
     /// A SLAM system (or another estimator of a higher layer), fed in the Map set.
     Scan(Box<dyn ScanEstimator>),
 }
@@ -31,11 +25,7 @@ impl Filter {
     /// The localizer's type name as written in scenario files.
     pub fn kind(&self) -> &'static str {
         match self {
-            Filter::Mcl(_) => "mcl",
-            Filter::MarkovGrid(_) => "markov_grid",
-            Filter::DeFilter(_) => "de_filter",
-            Filter::DeMc(_) => "de_mc",
-            Filter::DeOdometry(_) => "de_odometry",
+            Filter::Map(f) => f.kind(),
             Filter::Scan(f) => f.kind(),
         }
     }
@@ -43,11 +33,7 @@ impl Filter {
     /// Beams of a scan the filter reads.
     pub fn max_beams(&self) -> usize {
         match self {
-            Filter::Mcl(m) => m.config.max_beams,
-            Filter::MarkovGrid(g) => g.config.max_beams,
-            Filter::DeFilter(f) => f.config.max_beams,
-            Filter::DeMc(f) => f.config.max_beams,
-            Filter::DeOdometry(f) => f.config.max_beams,
+            Filter::Map(f) => f.max_beams(),
             Filter::Scan(_) => 0, // reads the whole scan
         }
     }
@@ -55,11 +41,7 @@ impl Filter {
     /// The latest estimate.
     pub fn estimate(&self) -> Option<PoseEstimate> {
         match self {
-            Filter::Mcl(m) => m.estimate,
-            Filter::MarkovGrid(g) => g.estimate,
-            Filter::DeFilter(f) => f.estimate(),
-            Filter::DeMc(f) => f.estimate(),
-            Filter::DeOdometry(f) => f.estimate,
+            Filter::Map(f) => f.estimate(),
             Filter::Scan(f) => f.estimate(),
         }
     }
@@ -67,6 +49,20 @@ impl Filter {
     /// True for estimators fed in the Map set (SLAM).
     pub fn is_scan(&self) -> bool {
         matches!(self, Filter::Scan(_))
+    }
+
+    /// The map localizer, if this is one.
+    pub fn as_map(&self) -> Option<&dyn MapLocalizer> {
+        match self {
+            Filter::Map(f) => Some(f.as_ref()),
+            Filter::Scan(_) => None,
+        }
+    }
+
+    /// The map localizer as a concrete type (`Mcl`, `MarkovGrid`, .. or a user's own), if it is
+    /// one.
+    pub fn downcast_ref<T: MapLocalizer + 'static>(&self) -> Option<&T> {
+        self.as_map()?.downcast_ref()
     }
 }
 
@@ -117,16 +113,14 @@ impl Localizer {
         let Some(map) = map else {
             return; // map-based filters only run where the map exists
         };
-        let beams = scan.beams(self.filter.max_beams());
-        let updated = match &mut self.filter {
-            Filter::Mcl(f) => f.update(map, beams, odom),
-            Filter::MarkovGrid(f) => f.update(map, &beams.returns(), beams.range_max, odom),
-            Filter::DeFilter(f) => f.update(map, beams, odom),
-            Filter::DeMc(f) => f.update(map, beams, odom),
-            Filter::DeOdometry(f) => f.update(&beams.returns(), odom),
-            Filter::Scan(_) => false,
+        let Filter::Map(f) = &mut self.filter else {
+            return;
         };
-        if updated && let Some(e) = self.filter.estimate() {
+        let beams = scan.beams(f.max_beams());
+        if f.predict(odom)
+            && f.correct(map, beams)
+            && let Some(e) = f.estimate()
+        {
             self.publish(scan_stamp, e);
         }
     }

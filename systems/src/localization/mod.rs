@@ -1,6 +1,7 @@
 //! Estimators: they read sensor readings only, never ground truth. Wheel odometry (which also
 //! provides the belief controllers navigate by), the odometry motion model the filters share,
-//! the map localizers believe in, and the localizers themselves (Monte Carlo localization).
+//! the map localizers believe in, and the localizers themselves (Monte Carlo localization and the
+//! others, behind one interface a user's own localizer implements too: [`MapLocalizer`]).
 
 pub mod de_filter;
 pub mod de_mc;
@@ -10,6 +11,7 @@ pub mod de_tracker;
 pub mod fixtures;
 pub mod localizer;
 pub mod map;
+pub mod map_localizer;
 pub mod markov_grid;
 pub mod mcl;
 pub mod motion_model;
@@ -24,8 +26,9 @@ pub(crate) mod test_drive;
 
 pub use localizer::{Filter, Localizer, Localizers, StampedEstimate};
 pub use map::LocalizationMap;
+pub use map_localizer::MapLocalizer;
 pub use markov_grid::{MarkovGrid, MarkovGridConfig};
-pub use mcl::{Mcl, MclConfig, PoseEstimate};
+pub use mcl::{BeamSubset, Mcl, MclConfig, PoseEstimate};
 pub use motion_model::OdometryMotionModel;
 pub use nav_source::NavSource;
 pub use odometry::{NavBelief, OdometryModel, WheelOdometry};

@@ -4,7 +4,8 @@
 //! - particle sets: MCL particles coloured by weight normalised to the heaviest (w / w_max),
 //!   DE populations coloured by cost rank (best first), Markov grid cells whose belief,
 //!   marginalised over θ, is at least [`GRID_MASS_FLOOR`] of the most probable cell's, coloured by
-//!   mass on a log scale; all on one dark-blue → yellow colormap (viridis), yellow = most likely;
+//!   mass on a log scale, a user's localizer's belief points coloured by their weight; all on one
+//!   dark-blue → yellow colormap (viridis), yellow = most likely;
 //! - the 2-σ ellipse of an estimate's (x, y) covariance and the ±2σ wedge of its heading.
 //!
 //! Sets larger than the cap are subsampled evenly (every k-th member in storage order, or in
@@ -12,6 +13,9 @@
 //! stay small whatever the particle count.
 
 use systems::localization::Filter;
+use systems::localization::de_filter::DeFilter;
+use systems::localization::de_mc::DeMc;
+use systems::localization::de_odometry::DeOdometry;
 use systems::localization::markov_grid::MarkovGrid;
 use systems::localization::mcl::Mcl;
 
@@ -132,23 +136,45 @@ pub fn grid_cloud(g: &MarkovGrid, cap: usize) -> Cloud {
     }
 }
 
-/// The particle set of a filter (None for those without one, like DE odometry).
+/// The particle set of a filter: ours drawn from their own state; any other map localizer (a
+/// user's) from its [`MapLocalizer::belief_points`]. None for those without one (DE odometry,
+/// SLAM systems).
 pub fn filter_cloud(f: &Filter, cap: usize) -> Option<Cloud> {
-    match f {
-        Filter::Mcl(m) => Some(mcl_cloud(m, cap)),
-        Filter::MarkovGrid(g) => Some(grid_cloud(g, cap)),
-        Filter::DeFilter(d) => Some(population_cloud(
+    // SLAM systems record their map and graph under robots/<name>/slam
+    let f = f.as_map()?;
+    if let Some(m) = f.downcast_ref::<Mcl>() {
+        Some(mcl_cloud(m, cap))
+    } else if let Some(g) = f.downcast_ref::<MarkovGrid>() {
+        Some(grid_cloud(g, cap))
+    } else if let Some(d) = f.downcast_ref::<DeFilter>() {
+        Some(population_cloud(
             &d.tracker.population.poses,
             &d.tracker.population.costs,
             cap,
-        )),
-        Filter::DeMc(d) => Some(population_cloud(
+        ))
+    } else if let Some(d) = f.downcast_ref::<DeMc>() {
+        Some(population_cloud(
             &d.tracker.population.poses,
             &d.tracker.population.costs,
             cap,
-        )),
-        // SLAM systems record their map and graph under robots/<name>/slam
-        Filter::DeOdometry(_) | Filter::Scan(_) => None,
+        ))
+    } else if f.downcast_ref::<DeOdometry>().is_some() {
+        None
+    } else {
+        f.belief_points().map(|p| points_cloud(&p, cap))
+    }
+}
+
+/// Weighted poses (the most likely weighing 1), coloured by weight.
+pub fn points_cloud(points: &[([f64; 2], f64)], cap: usize) -> Cloud {
+    let idx = even_subset(points.len(), cap);
+    Cloud {
+        points: idx
+            .iter()
+            .map(|&i| [points[i].0[0] as f32, points[i].0[1] as f32, 0.0])
+            .collect(),
+        colors: idx.iter().map(|&i| colormap(points[i].1)).collect(),
+        radius: 0.04,
     }
 }
 
@@ -210,6 +236,8 @@ pub fn heading_wedge(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use systems::core::Pose2;
+    use systems::localization::{BeamSubset, LocalizationMap, MapLocalizer, PoseEstimate};
 
     #[test]
     fn colormap_runs_from_dark_blue_to_yellow() {
@@ -253,5 +281,52 @@ mod tests {
         assert!(ellipse_2sigma(0.0, 0.0, &[[f64::NAN; 3]; 3], 8).is_none());
         let w = heading_wedge(0.0, 0.0, 0.0, 0.01, 1.0).unwrap();
         assert!((w[2][1] - 0.2f64.sin() as f32).abs() < 1e-6);
+    }
+
+    /// A user's localizer with its own belief points.
+    #[derive(Clone, Debug)]
+    struct Points(Vec<([f64; 2], f64)>);
+
+    impl MapLocalizer for Points {
+        fn kind(&self) -> &'static str {
+            "points"
+        }
+        fn max_beams(&self) -> usize {
+            0
+        }
+        fn predict(&mut self, _: &Pose2) -> bool {
+            false
+        }
+        fn correct(&mut self, _: &LocalizationMap, _: &BeamSubset) -> bool {
+            false
+        }
+        fn estimate(&self) -> Option<PoseEstimate> {
+            None
+        }
+        fn belief_points(&self) -> Option<Vec<([f64; 2], f64)>> {
+            (!self.0.is_empty()).then(|| self.0.clone())
+        }
+        fn box_clone(&self) -> Box<dyn MapLocalizer> {
+            Box::new(self.clone())
+        }
+        fn as_any(&self) -> &dyn std::any::Any {
+            self
+        }
+    }
+
+    #[test]
+    fn a_user_localizers_belief_points_become_a_cloud() {
+        let pts = vec![([1.0, 2.0], 1.0), ([3.0, 4.0], 0.0), ([5.0, 6.0], 0.5)];
+        let c = filter_cloud(&Filter::Map(Box::new(Points(pts))), 10).unwrap();
+        assert_eq!(
+            c.points,
+            vec![[1.0, 2.0, 0.0], [3.0, 4.0, 0.0], [5.0, 6.0, 0.0]]
+        );
+        assert_eq!(c.colors, vec![colormap(1.0), colormap(0.0), colormap(0.5)]);
+        let many: Vec<_> = (0..100).map(|k| ([k as f64, 0.0], 1.0)).collect();
+        let c = filter_cloud(&Filter::Map(Box::new(Points(many))), 10).unwrap();
+        assert_eq!(c.points.len(), 10);
+        // none drawn for a localizer without belief points
+        assert!(filter_cloud(&Filter::Map(Box::new(Points(Vec::new()))), 10).is_none());
     }
 }

@@ -25,7 +25,8 @@ pub mod prediction;
 pub mod refine;
 
 use super::map::LocalizationMap;
-use super::mcl::{InitialBelief, LaserModelParams, PoseEstimate};
+use super::map_localizer::MapLocalizer;
+use super::mcl::{BeamSubset, InitialBelief, LaserModelParams, PoseEstimate};
 use super::motion_model::{OdometryMotionModel, moved_enough};
 use crate::core::{Pose2, wrap_angle};
 use correction::PaddedField;
@@ -193,7 +194,7 @@ impl MarkovGrid {
     }
 
     /// Prediction for the odometry motion `from` → `to`.
-    pub fn predict(&mut self, from: &Pose2, to: &Pose2) {
+    pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
         prediction::shift(&self.layout, &d, &self.belief, &mut self.scratch);
         std::mem::swap(&mut self.belief, &mut self.scratch);
@@ -319,8 +320,8 @@ impl MarkovGrid {
         (runs, n)
     }
 
-    /// Correction by a scan's endpoints (base frame, max-range readings left out).
-    pub fn correct(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+    /// Correction of the belief by a scan's endpoints (base frame, max-range readings left out).
+    pub fn apply_scan(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
         if points.is_empty() {
             return;
         }
@@ -407,19 +408,17 @@ impl MarkovGrid {
         range_max: f32,
         odom: &Pose2,
     ) -> bool {
-        if let Some(last) = self.last_odom {
-            if !moved_enough(
-                &last,
-                odom,
-                self.config.update_min_d,
-                self.config.update_min_a,
-            ) {
-                return false;
-            }
-            self.predict(&last, odom);
-        }
-        self.last_odom = Some(*odom);
-        self.correct(map, points, range_max);
+        MapLocalizer::predict(self, odom) && self.correct_points(map, points, range_max)
+    }
+
+    /// The scan half of [`MarkovGrid::update`]: correction, then the estimate. Always true.
+    fn correct_points(
+        &mut self,
+        map: &LocalizationMap,
+        points: &[[f32; 2]],
+        range_max: f32,
+    ) -> bool {
+        self.apply_scan(map, points, range_max);
         self.updates += 1;
         self.estimate = self.estimate_pose().map(|mut e| {
             e.pose = refine::refine_pose(
@@ -509,6 +508,50 @@ impl MarkovGrid {
             }
         }
         m
+    }
+}
+
+/// [`MarkovGrid::update`] in two halves: the motion gate and prediction, then the correction by
+/// the scan's returns and the estimate.
+impl MapLocalizer for MarkovGrid {
+    fn kind(&self) -> &'static str {
+        "markov_grid"
+    }
+
+    fn max_beams(&self) -> usize {
+        self.config.max_beams
+    }
+
+    fn predict(&mut self, odom: &Pose2) -> bool {
+        if let Some(last) = self.last_odom {
+            if !moved_enough(
+                &last,
+                odom,
+                self.config.update_min_d,
+                self.config.update_min_a,
+            ) {
+                return false;
+            }
+            self.apply_motion(&last, odom);
+        }
+        self.last_odom = Some(*odom);
+        true
+    }
+
+    fn correct(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> bool {
+        self.correct_points(map, &beams.returns(), beams.range_max)
+    }
+
+    fn estimate(&self) -> Option<PoseEstimate> {
+        self.estimate
+    }
+
+    fn box_clone(&self) -> Box<dyn MapLocalizer> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 

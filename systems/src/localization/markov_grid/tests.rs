@@ -76,11 +76,11 @@ fn prediction_moves_the_mass_with_the_robot() {
     let mut odom = Pose2::IDENTITY;
     for _ in 0..4 {
         let next = odom.compose(&Pose2::new(0.25, 0.0, 0.0));
-        grid.predict(&odom, &next);
+        grid.apply_motion(&odom, &next);
         odom = next;
     }
     let next = odom.compose(&Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
-    grid.predict(&odom, &next);
+    grid.apply_motion(&odom, &next);
     let total: f64 = grid.belief.iter().map(|&v| v as f64).sum();
     assert!((total - 1.0).abs() < 1e-3, "{total}");
     let e = grid.estimate_pose().unwrap();

@@ -25,6 +25,7 @@ pub use resample::{BinSize, CountLimits, kld_bound, normal_quantile};
 pub use sensor_model::{BeamSubset, LaserModelParams};
 
 use super::map::LocalizationMap;
+use super::map_localizer::MapLocalizer;
 use super::motion_model::{OdometryMotionModel, moved_enough};
 use crate::core::{Pose2, SimRng, wrap_angle};
 use rand::{Rng, RngExt, SeedableRng};
@@ -200,7 +201,7 @@ impl Mcl {
     }
 
     /// Moves every particle by the odometry motion `from` → `to`.
-    pub fn predict(&mut self, from: &Pose2, to: &Pose2) {
+    pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
         let model = self.config.motion;
         let seeds: Vec<u64> = (0..self.len().div_ceil(MOTION_CHUNK))
@@ -265,62 +266,7 @@ impl Mcl {
     /// Consumes a scan taken when the odometry read `odom`. Returns true if the filter updated
     /// (the first scan, or enough motion since the last update).
     pub fn update(&mut self, map: &LocalizationMap, beams: &BeamSubset, odom: &Pose2) -> bool {
-        if let Some(last) = self.last_odom {
-            if !moved_enough(
-                &last,
-                odom,
-                self.config.update_min_d,
-                self.config.update_min_a,
-            ) {
-                return false;
-            }
-            self.predict(&last, odom);
-        }
-        self.last_odom = Some(*odom);
-        if beams.is_empty() {
-            return true;
-        }
-        let mean_p = self.weigh(map, beams);
-        // Augmented MCL: the likelihood is normalised per beam count so α's mean the same for
-        // every laser
-        let avg = mean_p.max(f64::MIN_POSITIVE);
-        // Both averages start as the plain mean of the updates so far (an exponential average
-        // that starts at the first value stays for ~1/α updates near it: a first update of a
-        // spread-out filter fits poorly, and w_slow would then sit too low to ever trigger).
-        self.averaged += 1;
-        let early = 1.0 / self.averaged as f64;
-        let (a_slow, a_fast) = (
-            self.config.recovery_alpha_slow.max(early),
-            self.config.recovery_alpha_fast.max(early),
-        );
-        self.w_slow += a_slow * (avg - self.w_slow);
-        self.w_fast += a_fast * (avg - self.w_fast);
-        let p_inject = if self.config.recovery_alpha_slow > 0.0 {
-            let ratio = self.w_fast / self.w_slow;
-            (1.0 - ratio / self.config.recovery_ratio).max(0.0)
-        } else {
-            0.0
-        };
-        let n_eff = 1.0 / self.w.iter().map(|w| w * w).sum::<f64>();
-        let challenger = if p_inject > 0.0 {
-            None
-        } else {
-            self.challenge(map, beams)
-        };
-
-        if let Some(pool) = challenger {
-            self.resample(map, self.config.challenge_fraction, Some(&pool));
-        } else if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
-            // Unlike AMCL, the averages are not reset after an injection (Table 8.3 has no
-            // reset): AMCL's reset ends the injection after one burst of a few percent, which
-            // rarely finds a kidnapped robot; here random particles keep coming while the
-            // scans fit worse than they used to.
-            let pool = self.injection_pool(map, beams, p_inject);
-            self.resample(map, p_inject, pool.as_ref());
-        }
-        self.updates += 1;
-        self.estimate = self.cluster();
-        true
+        MapLocalizer::predict(self, odom) && MapLocalizer::correct(self, map, beams)
     }
 
     /// The poses injected particles are drawn from (see [`MclConfig::injection_candidates`]);
@@ -439,6 +385,93 @@ impl Mcl {
     /// The odometry pose of the last update.
     pub fn last_odometry(&self) -> Option<Pose2> {
         self.last_odom
+    }
+}
+
+/// [`Mcl::update`] in two halves: the motion gate and motion sampling, then weighing, injection,
+/// resampling and the estimate.
+impl MapLocalizer for Mcl {
+    fn kind(&self) -> &'static str {
+        "mcl"
+    }
+
+    fn max_beams(&self) -> usize {
+        self.config.max_beams
+    }
+
+    fn predict(&mut self, odom: &Pose2) -> bool {
+        if let Some(last) = self.last_odom {
+            if !moved_enough(
+                &last,
+                odom,
+                self.config.update_min_d,
+                self.config.update_min_a,
+            ) {
+                return false;
+            }
+            self.apply_motion(&last, odom);
+        }
+        self.last_odom = Some(*odom);
+        true
+    }
+
+    fn correct(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> bool {
+        if beams.is_empty() {
+            return true;
+        }
+        let mean_p = self.weigh(map, beams);
+        // Augmented MCL: the likelihood is normalised per beam count so α's mean the same for
+        // every laser
+        let avg = mean_p.max(f64::MIN_POSITIVE);
+        // Both averages start as the plain mean of the updates so far (an exponential average
+        // that starts at the first value stays for ~1/α updates near it: a first update of a
+        // spread-out filter fits poorly, and w_slow would then sit too low to ever trigger).
+        self.averaged += 1;
+        let early = 1.0 / self.averaged as f64;
+        let (a_slow, a_fast) = (
+            self.config.recovery_alpha_slow.max(early),
+            self.config.recovery_alpha_fast.max(early),
+        );
+        self.w_slow += a_slow * (avg - self.w_slow);
+        self.w_fast += a_fast * (avg - self.w_fast);
+        let p_inject = if self.config.recovery_alpha_slow > 0.0 {
+            let ratio = self.w_fast / self.w_slow;
+            (1.0 - ratio / self.config.recovery_ratio).max(0.0)
+        } else {
+            0.0
+        };
+        let n_eff = 1.0 / self.w.iter().map(|w| w * w).sum::<f64>();
+        let challenger = if p_inject > 0.0 {
+            None
+        } else {
+            self.challenge(map, beams)
+        };
+
+        if let Some(pool) = challenger {
+            self.resample(map, self.config.challenge_fraction, Some(&pool));
+        } else if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
+            // Unlike AMCL, the averages are not reset after an injection (Table 8.3 has no
+            // reset): AMCL's reset ends the injection after one burst of a few percent, which
+            // rarely finds a kidnapped robot; here random particles keep coming while the
+            // scans fit worse than they used to.
+            let pool = self.injection_pool(map, beams, p_inject);
+            self.resample(map, p_inject, pool.as_ref());
+        }
+        self.updates += 1;
+        self.estimate = self.cluster();
+        true
+    }
+
+    fn estimate(&self) -> Option<PoseEstimate> {
+        self.estimate
+    }
+
+    fn box_clone(&self) -> Box<dyn MapLocalizer> {
+        Box::new(self.clone())
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
     }
 }
 
