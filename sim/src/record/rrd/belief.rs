@@ -137,8 +137,8 @@ pub fn grid_cloud(g: &MarkovGrid, cap: usize) -> Cloud {
 }
 
 /// The particle set of a filter: ours drawn from their own state; any other map localizer (a
-/// user's) from its [`MapLocalizer::belief_points`]. None for those without one (DE odometry,
-/// SLAM systems).
+/// user's) from its [`systems::localization::MapLocalizer::belief_points`]. None for those
+/// without one (DE odometry, SLAM systems).
 pub fn filter_cloud(f: &Filter, cap: usize) -> Option<Cloud> {
     // SLAM systems record their map and graph under robots/<name>/slam
     let f = f.as_map()?;
