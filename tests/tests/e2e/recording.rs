@@ -97,3 +97,37 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
     let timelines = v["timelines"].as_array().unwrap();
     assert!(timelines.iter().any(|t| t == "sim_time"), "{timelines:?}");
 }
+
+/// A user controller that panics ends the run with an error naming the robot and the tick, and
+/// the recording written up to then is finished: Rerun's own tools read it.
+#[test]
+fn a_panicking_controller_leaves_a_finished_recording() {
+    use sim::prelude::{Observation, SimError, Simulation, Twist};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("crash.rrd");
+    let text = format!(
+        "{SQUARE_ROOM}\n[[robots]]\nname = \"r1\"\nstart = [5.0, 5.0, 0.0]\n\
+         [robots.sensors.laser]\n[robots.sensors.encoder]\n"
+    )
+    .replace("duration = 1.0", "duration = 5.0");
+    let err = Simulation::from_toml(&text, "crash")
+        .rrd(&path)
+        .controller("r1", |o: &Observation| {
+            assert!(o.tick < 30, "the controller gave up");
+            Twist { v: 0.3, w: 0.0 }
+        })
+        .build()
+        .unwrap()
+        .run()
+        .err()
+        .expect("the run fails");
+    assert!(
+        matches!(err.downcast_ref::<SimError>(), Some(SimError::ControllerFailed { robot, tick: 30, .. }) if robot == "r1"),
+        "{err}"
+    );
+    assert!(std::fs::metadata(&path).unwrap().len() > 0);
+    if let Some(report) = check_rrd(&path) {
+        let text = report.to_string();
+        assert!(text.contains("robots/r1"), "{text}");
+    }
+}
