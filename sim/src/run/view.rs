@@ -124,7 +124,11 @@ impl<'w> RobotView<'w> {
                     converged_after: samples
                         .and_then(|s| s.per_localizer.iter().find(|(n, _)| *n == l.name))
                         .and_then(|(_, s)| {
-                            convergence_index(s, CONVERGENCE_HOLD_S).map(|i| s[i].t)
+                            // converged once the tracking has held for the hold time
+                            let last = s.last()?.t;
+                            convergence_index(s, CONVERGENCE_HOLD_S)
+                                .map(|i| s[i].t)
+                                .filter(|t| last - t >= CONVERGENCE_HOLD_S)
                         }),
                     filter: &l.filter,
                 })
@@ -221,7 +225,8 @@ pub struct LocalizerView<'w> {
     /// The latest estimate (None before its first).
     pub estimate: Option<Estimate>,
     /// When its estimates came and stayed close to the truth (the summary's convergence,
-    /// judged on the estimates so far; s), None if not (yet).
+    /// judged on the estimates so far: known once they have stayed close for the summary's
+    /// hold time; s), None if not (yet).
     pub converged_after: Option<f64>,
     filter: &'w Filter,
 }
