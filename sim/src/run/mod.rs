@@ -5,6 +5,7 @@
 //! the recordings and exports are then finished as after the last tick, and the summary covers
 //! the ticks run.
 
+mod attach;
 pub mod capture;
 pub mod command;
 pub mod controller;
