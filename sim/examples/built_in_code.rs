@@ -81,9 +81,11 @@ fn run(duration_s: f64) -> anyhow::Result<Vec<RobotReport>> {
         .iter()
         .map(|r| {
             let pose = r.pose();
-            // the localizer's latest estimate against the ground truth
+            // the localizer's latest estimate against the ground truth (robots without MCL
+            // have none)
             let mcl_error_m = r
                 .localizer("mcl")
+                .ok()
                 .and_then(|l| l.estimate)
                 .map(|e| (e.pose.x - pose.x).hypot(e.pose.y - pose.y));
             RobotReport {

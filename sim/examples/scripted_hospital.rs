@@ -40,10 +40,7 @@ fn run(max_seconds: f64) -> anyhow::Result<Report> {
             s.command("r2", Command::GoTo(Target::Place("ward_3".into())))?;
             report.door_closed_at = Some(now);
         }
-        let mcl_converged = s
-            .robot("r3")?
-            .localizer("mcl")
-            .is_some_and(|l| l.converged_after.is_some());
+        let mcl_converged = s.robot("r3")?.localizer("mcl")?.converged_after.is_some();
         if report.kidnapped_at.is_none() && mcl_converged {
             let to = s.scenario().places["corridor_north_w"];
             s.command("r3", Command::Teleport(to))?;
@@ -60,8 +57,8 @@ fn run(max_seconds: f64) -> anyhow::Result<Report> {
     }
     let r3 = s.robot("r3")?;
     report.r3_error_m = r3
-        .localizer("mcl")
-        .and_then(|l| l.estimate)
+        .localizer("mcl")?
+        .estimate
         .map(|e| e.pose.distance(&r3.pose()));
     report.seconds = s.time();
     report.log = s.finish()?.log;

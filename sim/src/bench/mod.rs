@@ -2,6 +2,7 @@
 //! ([`machine`]), which their JSON rows name.
 
 pub mod batch;
+pub mod facade;
 pub mod localization;
 pub mod machine;
 pub mod matching;

@@ -5,7 +5,6 @@
 
 use crate::scenario::{Event, EventAction, RobotConfig, SensorName};
 use bevy_ecs::prelude::*;
-use systems::body::DriveCommand;
 use systems::body::{Physics, PhysicsBody, TruePose};
 use systems::core::{SimClock, SimPlugin, SimSet};
 use systems::localization::LocalizationMap;
@@ -139,10 +138,19 @@ pub fn fire_events(
                     if *active { "on" } else { "off" }
                 )
             }
-            EventAction::Drive { v, w } => {
+            EventAction::Drive(cmd) => {
                 let Some(mut held) = held else { continue };
-                held.0 = Some(DriveCommand { v: *v, w: *w });
-                format!("drive command held: v {v:.2} m/s, w {w:.2} rad/s")
+                held.0 = Some(*cmd);
+                match cmd.steer {
+                    Some(steer) => format!(
+                        "drive command held: speed {:.2} m/s, steer {steer:.3} rad",
+                        cmd.v
+                    ),
+                    None => format!(
+                        "drive command held: v {:.2} m/s, w {:.2} rad/s",
+                        cmd.v, cmd.w
+                    ),
+                }
             }
             EventAction::ReleaseDrive => {
                 let Some(mut held) = held else { continue };

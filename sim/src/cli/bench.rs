@@ -12,6 +12,9 @@ pub enum BenchCommand {
     Batch(bench::batch::BenchBatchArgs),
     /// Real-time factor and rays/s for swarms of wandering robots with lasers at 10 Hz.
     Swarm(bench::swarm::SwarmOptions),
+    /// A tick through the library facade against the bare schedule, alternating on one world:
+    /// the median of the paired differences.
+    Facade(bench::facade::FacadeBenchOptions),
     /// Real-time factor and time per scan of each SLAM mode on the hospital loop run.
     Slam(bench::slam::SlamBenchOptions),
     /// DE scan-matching time per alignment of 1081-beam hospital scans (one core).
@@ -29,6 +32,7 @@ pub fn bench_command(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Record(o) => bench::record::run_record_bench(&o).map(drop),
         BenchCommand::Batch(a) => bench::batch::run_batch_bench(&a).map(drop),
         BenchCommand::Swarm(o) => bench::swarm::run_swarm_bench(&o),
+        BenchCommand::Facade(o) => bench::facade::run_facade_bench(&o),
         BenchCommand::Slam(o) => bench::slam::run_slam_bench(&o).map(drop),
         BenchCommand::DeMatch(o) => bench::matching::run_de_match_bench(&o),
         BenchCommand::Mcl(o) => bench::localization::run_mcl_bench(&o),

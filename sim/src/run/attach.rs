@@ -2,7 +2,7 @@
 //! `ScanEstimator` or `MapLocalizer` in the robot's `Localizers`) and its controllers (in the
 //! Control set, in place of the robot's behaviour or navigator).
 
-use super::command::SimError;
+use super::command::{SimError, names};
 use super::controller::{Controlled, Controller, UserControllers, run_user_controllers};
 use crate::build::SimWorld;
 use crate::scenario::Scenario;
@@ -130,14 +130,4 @@ pub(super) fn attach_controllers(
             .before(apply_held_commands),
     );
     Ok(())
-}
-
-/// `a, b, c`, or `none`: the known names an error lists.
-pub(super) fn names<'a>(names: impl Iterator<Item = &'a str>) -> String {
-    let v: Vec<&str> = names.collect();
-    if v.is_empty() {
-        "none".into()
-    } else {
-        v.join(", ")
-    }
 }

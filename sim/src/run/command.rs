@@ -3,6 +3,7 @@
 //! Script set, exactly as the same event written in the scenario file would.
 
 use crate::scenario::{EventAction, SensorName};
+use systems::body::{DriveCommand, Kinematics};
 use systems::core::Pose2;
 use systems::navigation::{Goal, Task, TaskKind};
 
@@ -21,6 +22,10 @@ pub enum Command {
     /// A velocity command (forward m/s, yaw rate rad/s; an Ackermann robot steers to that yaw
     /// rate) held until replaced or released; the robot's limits still apply.
     Drive { v: f64, w: f64 },
+    /// A car's (Ackermann robot's) command in its own terms: forward speed (m/s) and steering
+    /// angle (rad, within the car's `max_steer`), held like [`Command::Drive`]. The wheels turn to
+    /// the angle at the car's steering rate, also at a standstill.
+    Steer { speed: f64, steer: f64 },
     /// Drops the held velocity command: the behaviour or navigator drives again.
     Release,
     /// Sends a navigating robot (one with tasks) to a place or a point: a `go` task appended
@@ -44,10 +49,18 @@ pub enum Target {
 pub enum SimError {
     #[error("no robot named `{name}` (robots: {known})")]
     UnknownRobot { name: String, known: String },
+    #[error("robot `{robot}` has no localizer or SLAM system named `{name}` (it has: {known})")]
+    UnknownLocalizer {
+        robot: String,
+        name: String,
+        known: String,
+    },
     #[error("no door named `{name}` (doors: {known})")]
     UnknownDoor { name: String, known: String },
     #[error("robot `{robot}` has no {sensor}")]
     NoSuchSensor { robot: String, sensor: String },
+    #[error("robot `{robot}` has a differential drive; {what} drives a car (Ackermann)")]
+    NotACar { robot: String, what: &'static str },
     #[error("robot `{robot}` follows navigation tasks, not waypoints")]
     NotOnWaypoints { robot: String },
     #[error("robot `{robot}` has no task queue (a robot with `[[robots.tasks]]` takes tasks)")]
@@ -81,7 +94,11 @@ pub enum SimError {
 impl Command {
     /// The scenario event action of the command, after checking its numbers (`robot` names it
     /// in errors).
-    pub(super) fn action(self, robot: &str) -> Result<EventAction, SimError> {
+    pub(super) fn action(
+        self,
+        robot: &str,
+        kinematics: &Kinematics,
+    ) -> Result<EventAction, SimError> {
         let finite = |what: String, v: &[f64]| {
             if v.iter().all(|x| x.is_finite()) {
                 Ok(())
@@ -116,7 +133,24 @@ impl Command {
             }
             Command::Drive { v, w } => {
                 finite(format!("drive command of `{robot}`"), &[v, w])?;
-                Ok(EventAction::Drive { v, w })
+                Ok(EventAction::Drive(DriveCommand::new(v, w)))
+            }
+            Command::Steer { speed, steer } => {
+                let Kinematics::Ackermann(car) = kinematics else {
+                    return Err(SimError::NotACar {
+                        robot: robot.to_string(),
+                        what: "a speed/steer command",
+                    });
+                };
+                finite(format!("speed/steer command of `{robot}`"), &[speed, steer])?;
+                if steer.abs() > car.max_steer {
+                    return Err(SimError::BadValue {
+                        what: format!("steering angle of `{robot}`"),
+                        expected: "an angle within the car's max_steer",
+                        got: format!("{steer} rad (max_steer {} rad)", car.max_steer),
+                    });
+                }
+                Ok(EventAction::Drive(car.command(speed, steer)))
             }
             Command::Release => Ok(EventAction::ReleaseDrive),
             Command::GoTo(Target::Point(p)) => {
@@ -182,4 +216,14 @@ fn non_negative(what: &str, v: &[f64]) -> Result<(), SimError> {
         expected: "times of 0 s or more",
         got: format!("{v:?}"),
     })
+}
+
+/// `a, b, c`, or `none`: the known names an error lists.
+pub(super) fn names<'a>(names: impl Iterator<Item = &'a str>) -> String {
+    let v: Vec<&str> = names.collect();
+    if v.is_empty() {
+        "none".into()
+    } else {
+        v.join(", ")
+    }
 }

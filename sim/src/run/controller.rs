@@ -83,7 +83,7 @@ pub(crate) fn run_user_controllers(world: &mut World) {
             let out = catch_unwind(AssertUnwindSafe(|| c.controller.control(&observation)));
             let failed = match out {
                 Ok(t) if t.v.is_finite() && t.w.is_finite() => {
-                    commands.push((c.entity, DriveCommand { v: t.v, w: t.w }));
+                    commands.push((c.entity, DriveCommand::new(t.v, t.w)));
                     continue;
                 }
                 Ok(t) => format!(

@@ -15,8 +15,8 @@
 //! # anyhow::Ok(())
 //! ```
 
-use super::attach::{attach_controllers, attach_estimators, names};
-use super::command::{Command, SimError, Target, go_task};
+use super::attach::{attach_controllers, attach_estimators};
+use super::command::{Command, SimError, Target, go_task, names};
 use super::controller::{Controller, UserControllers};
 use super::exports::{Exported, RunExports};
 use super::outputs;
@@ -576,7 +576,7 @@ impl Simulation {
             }
             _ => {}
         }
-        let action = command.action(robot)?;
+        let action = command.action(robot, &config.kinematics)?;
         match &action {
             EventAction::Teleport(p) => {
                 let what = format!("teleport pose of `{robot}`");

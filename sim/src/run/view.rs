@@ -2,6 +2,7 @@
 //! what a script or a user's program reads instead of querying the ECS world. A view borrows
 //! the world; it is taken again after each step.
 
+use super::command::{SimError, names};
 use bevy_ecs::prelude::*;
 use systems::body::{Collisions, TruePose, TrueTwist};
 use systems::core::Pose2;
@@ -137,8 +138,16 @@ impl<'w> RobotView<'w> {
     }
 
     /// The localizer or SLAM system called `name`.
-    pub fn localizer(&self, name: &str) -> Option<LocalizerView<'w>> {
-        self.localizers().into_iter().find(|l| l.name == name)
+    pub fn localizer(&self, name: &str) -> Result<LocalizerView<'w>, SimError> {
+        let mut all = self.localizers();
+        match all.iter().position(|l| l.name == name) {
+            Some(i) => Ok(all.swap_remove(i)),
+            None => Err(SimError::UnknownLocalizer {
+                robot: self.name.to_string(),
+                name: name.to_string(),
+                known: names(all.iter().map(|l| l.name)),
+            }),
+        }
     }
 
     /// The navigator's tasks and state (None for a robot driven by a behaviour).

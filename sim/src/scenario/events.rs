@@ -6,6 +6,7 @@ use super::check::{Checker, R};
 use super::error::KeyPath;
 use super::model::{DoorConfig, Event, EventAction, RobotConfig, SensorName};
 use serde::Deserialize;
+use systems::body::{DriveCommand, Kinematics};
 use systems::core::Pose2;
 use systems::world::OccupancyGrid;
 
@@ -48,14 +49,27 @@ pub struct EventFile {
     // door
     pub door: Option<String>,
     pub open: Option<bool>,
-    // drive: the held velocity command (m/s, rad/s)
+    // drive: the held velocity command (m/s, rad/s), or a car's speed (m/s) and steering
+    // angle (rad)
     pub v: Option<f64>,
     pub w: Option<f64>,
+    pub speed: Option<f64>,
+    pub steer: Option<f64>,
     /// tasks: appended to the robot's task queue (same tables as `[[robots.tasks]]`)
     pub tasks: Option<Vec<super::navigation::TaskFile>>,
 }
 
 impl EventFile {
+    /// The keys of drive events, and whether each is given.
+    fn drive_keys(&self) -> [(&'static str, bool); 4] {
+        [
+            ("v", self.v.is_some()),
+            ("w", self.w.is_some()),
+            ("speed", self.speed.is_some()),
+            ("steer", self.steer.is_some()),
+        ]
+    }
+
     /// The keys of waypoints, teleport and sensor_fault events, and whether each is given.
     fn route_pose_and_sensor_keys(&self) -> [(&'static str, bool); 6] {
         [
@@ -120,8 +134,11 @@ fn resolve_door_event(
             "a door event concerns no robot: remove `robot`",
         );
     }
-    let speeds = [("v", e.v.is_some()), ("w", e.w.is_some())];
-    for (key, present) in e.route_pose_and_sensor_keys().into_iter().chain(speeds) {
+    for (key, present) in e
+        .route_pose_and_sensor_keys()
+        .into_iter()
+        .chain(e.drive_keys())
+    {
         if present {
             return c.err(
                 &p.key(key),
@@ -173,8 +190,9 @@ fn resolve_robot_event(
             format!("`{key}` applies to `door` events only"),
         );
     }
-    if e.kind != EventType::Drive && (e.v.is_some() || e.w.is_some()) {
-        let key = if e.v.is_some() { "v" } else { "w" };
+    if e.kind != EventType::Drive
+        && let Some((key, _)) = e.drive_keys().into_iter().find(|(_, present)| *present)
+    {
         return c.err(
             &p.key(key),
             format!("`{key}` applies to `drive` events only"),
@@ -305,6 +323,8 @@ fn resolve_robot_event(
             }
             if e.kind == EventType::Release {
                 EventAction::ReleaseDrive
+            } else if e.speed.is_some() || e.steer.is_some() {
+                resolve_speed_steer(c, p, e, robot)?
             } else {
                 let speed = |key: &str, v: Option<f64>| match v {
                     Some(v) => c.range(&p.key(key), v, None, None, false),
@@ -313,12 +333,48 @@ fn resolve_robot_event(
                         format!("a drive event needs `{key}` (`v` in m/s, `w` in rad/s)"),
                     ),
                 };
-                EventAction::Drive {
-                    v: speed("v", e.v)?,
-                    w: speed("w", e.w)?,
-                }
+                EventAction::Drive(DriveCommand::new(speed("v", e.v)?, speed("w", e.w)?))
             }
         }
     };
     Ok(action)
+}
+
+/// A drive event's speed/steer form: a car's forward speed (m/s) and steering angle (rad, within
+/// its `max_steer`).
+fn resolve_speed_steer(
+    c: &Checker,
+    p: &KeyPath,
+    e: &EventFile,
+    robot: &RobotConfig,
+) -> R<EventAction> {
+    for (key, present) in [("v", e.v.is_some()), ("w", e.w.is_some())] {
+        if present {
+            return c.err(
+                &p.key(key),
+                format!("`{key}` and `speed`/`steer` are two forms of a drive event: give one"),
+            );
+        }
+    }
+    let Kinematics::Ackermann(car) = &robot.kinematics else {
+        let key = if e.steer.is_some() { "steer" } else { "speed" };
+        return c.err(
+            &p.key(key),
+            format!(
+                "`speed` and `steer` drive a car (Ackermann); robot `{}` has a differential \
+                 drive: give `v` (m/s) and `w` (rad/s)",
+                robot.name
+            ),
+        );
+    };
+    let (Some(speed), Some(steer)) = (e.speed, e.steer) else {
+        return c.err(
+            p,
+            "a speed/steer drive event needs both `speed` (m/s) and `steer` (rad)",
+        );
+    };
+    let speed = c.range(&p.key("speed"), speed, None, None, false)?;
+    let max = car.max_steer;
+    let steer = c.range(&p.key("steer"), steer, Some(-max), Some(max), false)?;
+    Ok(EventAction::Drive(car.command(speed, steer)))
 }

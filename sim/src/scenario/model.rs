@@ -126,12 +126,9 @@ pub enum EventAction {
         index: usize,
         open: bool,
     },
-    /// A velocity command (m/s, rad/s) held on the robot: it replaces what its behaviour or
-    /// navigator commands until released.
-    Drive {
-        v: f64,
-        w: f64,
-    },
+    /// A velocity command (m/s, rad/s; or a car's speed and steering angle) held on the robot:
+    /// it replaces what its behaviour or navigator commands until released.
+    Drive(systems::body::DriveCommand),
     /// The held command is dropped: the behaviour or navigator drives again.
     ReleaseDrive,
     /// Tasks appended to a navigating robot's queue.

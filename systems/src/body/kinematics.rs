@@ -45,6 +45,17 @@ pub struct DriveCommand {
     pub v: f64,
     /// Yaw rate (rad/s).
     pub w: f64,
+    /// A car's steering angle (rad) given directly (the speed/steer form): an Ackermann drive
+    /// steers to it instead of to the angle `w` asks for, also at a standstill. Differential
+    /// drives ignore it.
+    pub steer: Option<f64>,
+}
+
+impl DriveCommand {
+    /// The (v, ω) form.
+    pub const fn new(v: f64, w: f64) -> DriveCommand {
+        DriveCommand { v, w, steer: None }
+    }
 }
 
 /// Actuator state, advanced by the physics step.
@@ -102,6 +113,16 @@ impl Ackermann {
     pub fn yaw_rate(&self, speed: f64, steer: f64) -> f64 {
         speed * steer.tan() / self.wheelbase
     }
+
+    /// The speed/steer command: forward `speed` (m/s) with the wheels at `steer` (rad); its
+    /// `w` is the yaw rate that steering gives at that speed (what recordings show).
+    pub fn command(&self, speed: f64, steer: f64) -> DriveCommand {
+        DriveCommand {
+            v: speed,
+            w: self.yaw_rate(speed, steer),
+            steer: Some(steer),
+        }
+    }
 }
 
 impl Kinematics {
@@ -119,7 +140,11 @@ impl Kinematics {
             Kinematics::Ackermann(a) => {
                 let target_v = cmd.v.clamp(-a.max_speed, a.max_speed);
                 state.speed = approach(state.speed, target_v, a.max_accel * dt);
-                if let Some(target_steer) = a.steer_for(cmd.v, cmd.w) {
+                let target = match cmd.steer {
+                    Some(steer) => Some(steer.clamp(-a.max_steer, a.max_steer)),
+                    None => a.steer_for(cmd.v, cmd.w),
+                };
+                if let Some(target_steer) = target {
                     state.steer = approach(state.steer, target_steer, a.max_steer_rate * dt);
                 }
                 (state.speed, a.yaw_rate(state.speed, state.steer))
@@ -182,7 +207,7 @@ mod tests {
             max_wheel_speed: 10.0,
             max_wheel_accel: 1000.0,
         };
-        let cmd = DriveCommand { v: 2.0, w: 2.0 };
+        let cmd = DriveCommand::new(2.0, 2.0);
         let (l, r) = d.wheel_targets(&cmd);
         assert!(r <= 10.0 + 1e-12 && l > 0.0);
         let (v, w) = d.twist(l, r);
@@ -202,7 +227,7 @@ mod tests {
             max_wheel_accel: 10.0,
         });
         let mut s = DriveState::default();
-        let cmd = DriveCommand { v: 1.0, w: 0.0 };
+        let cmd = DriveCommand::new(1.0, 0.0);
         let (v, _) = k.step(&cmd, &mut s, 0.1);
         assert!((v - 0.1).abs() < 1e-12); // 10 rad/s² · 0.1 s · 0.1 m
         for _ in 0..20 {
@@ -223,17 +248,62 @@ mod tests {
             wheel_radius: 0.05,
         });
         let mut s = DriveState::default();
-        let (v, w) = k.step(&DriveCommand { v: 0.0, w: 1.0 }, &mut s, 0.1);
+        let (v, w) = k.step(&DriveCommand::new(0.0, 1.0), &mut s, 0.1);
         assert_eq!((v, w), (0.0, 0.0));
         // steering is rate limited and clamped
         let mut s = DriveState::default();
-        k.step(&DriveCommand { v: 1.0, w: 10.0 }, &mut s, 0.1);
+        k.step(&DriveCommand::new(1.0, 10.0), &mut s, 0.1);
         assert!((s.steer - 0.1).abs() < 1e-12);
         for _ in 0..20 {
-            k.step(&DriveCommand { v: 1.0, w: 10.0 }, &mut s, 0.1);
+            k.step(&DriveCommand::new(1.0, 10.0), &mut s, 0.1);
         }
         assert!((s.steer - 0.5).abs() < 1e-12);
-        let (v, w) = k.step(&DriveCommand { v: 1.0, w: 10.0 }, &mut s, 0.1);
+        let (v, w) = k.step(&DriveCommand::new(1.0, 10.0), &mut s, 0.1);
         assert!((w - v * 0.5f64.tan() / 0.35).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_speed_steer_command_steers_at_a_standstill_and_holds_its_angle() {
+        let car = Ackermann {
+            wheelbase: 0.35,
+            max_steer: 0.5,
+            max_steer_rate: 1.0,
+            max_speed: 2.0,
+            max_accel: 100.0,
+            wheel_radius: 0.05,
+        };
+        let k = Kinematics::Ackermann(car.clone());
+        let mut s = DriveState::default();
+        // standing: the wheels turn (at the steering rate), the car does not
+        let (v, w) = k.step(&car.command(0.0, -0.3), &mut s, 0.1);
+        assert_eq!((v, w), (0.0, 0.0));
+        assert!((s.steer + 0.1).abs() < 1e-12, "{s:?}");
+        for _ in 0..5 {
+            k.step(&car.command(0.0, -0.3), &mut s, 0.1);
+        }
+        assert!((s.steer + 0.3).abs() < 1e-12, "{s:?}");
+        // rolling: the angle stays where it was sent; the yaw rate is the bicycle model's
+        let cmd = car.command(1.0, -0.3);
+        assert!((cmd.w - car.yaw_rate(1.0, -0.3)).abs() < 1e-12);
+        let (v, w) = k.step(&cmd, &mut s, 0.1);
+        assert!((s.steer + 0.3).abs() < 1e-12, "{s:?}");
+        assert!((w - v * (-0.3f64).tan() / 0.35).abs() < 1e-12);
+        // a differential drive goes by (v, ω) alone
+        let d = Kinematics::DiffDrive(DiffDrive {
+            wheel_base: 0.5,
+            wheel_radius: 0.1,
+            max_wheel_speed: 20.0,
+            max_wheel_accel: 1000.0,
+        });
+        let mut a = DriveState::default();
+        let mut b = DriveState::default();
+        let with_steer = DriveCommand {
+            steer: Some(0.4),
+            ..DriveCommand::new(0.5, 0.2)
+        };
+        assert_eq!(
+            d.step(&with_steer, &mut a, 0.1),
+            d.step(&DriveCommand::new(0.5, 0.2), &mut b, 0.1)
+        );
     }
 }

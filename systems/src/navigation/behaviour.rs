@@ -157,7 +157,7 @@ impl Behaviour {
             v = 0.1 * self.speed; // a car must roll to turn
         }
         let w = (2.0 * heading).clamp(-self.max_yaw_rate, self.max_yaw_rate);
-        DriveCommand { v, w }
+        DriveCommand::new(v, w)
     }
 }
 

@@ -26,8 +26,8 @@ mod tests {
     #[test]
     fn a_held_command_replaces_the_drivers_and_release_hands_back() {
         let mut world = World::new();
-        let driven = DriveCommand { v: 0.5, w: 0.1 };
-        let held = DriveCommand { v: -0.2, w: 1.0 };
+        let driven = DriveCommand::new(0.5, 0.1);
+        let held = DriveCommand::new(-0.2, 1.0);
         let a = world.spawn((HeldCommand(Some(held)), driven)).id();
         let b = world.spawn((HeldCommand(None), driven)).id();
         let mut schedule = Schedule::default();

@@ -502,7 +502,7 @@ impl Navigator {
                         }
                         self.next_step(now);
                     }
-                    return DriveCommand { v: out.v, w: out.w };
+                    return DriveCommand::new(out.v, out.w);
                 }
                 // held by the obstacle: not moving forward and not turning on the spot (or not
                 // moving at all)
@@ -528,7 +528,7 @@ impl Navigator {
                     self.phase = Phase::Planning;
                     self.log(now, "off the path: re-planning");
                 }
-                DriveCommand { v: out.v, w: out.w }
+                DriveCommand::new(out.v, out.w)
             }
             Phase::Blocked { since } => {
                 self.metrics.waiting_time_s += ctx.dt;
@@ -576,10 +576,7 @@ impl Navigator {
         let aw = self.params.follower.max_yaw_accel * dt;
         self.follower.v -= self.follower.v.clamp(-a, a);
         self.follower.w -= self.follower.w.clamp(-aw, aw);
-        DriveCommand {
-            v: self.follower.v,
-            w: self.follower.w,
-        }
+        DriveCommand::new(self.follower.v, self.follower.w)
     }
 }
 

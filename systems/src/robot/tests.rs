@@ -40,7 +40,7 @@ fn a_robot_from_the_bundle_drives_where_it_is_told() {
             "r1", 0, start, footprint, drive, body, idle,
         ))
         .id();
-    world.get_mut::<HeldCommand>(robot).unwrap().0 = Some(DriveCommand { v: 0.5, w: 0.0 });
+    world.get_mut::<HeldCommand>(robot).unwrap().0 = Some(DriveCommand::new(0.5, 0.0));
     let mut schedule = new_schedule();
     schedule.add_systems(apply_held_commands.in_set(SimSet::Control));
     PhysicsPlugin.build(&mut world, &mut schedule);

@@ -37,7 +37,7 @@ fn physics_follows_closed_form_arcs() {
     ));
     let e = sim.robots[0];
     sim.world.entity_mut(e).remove::<Behaviour>();
-    let cmd = DriveCommand { v: 1.0, w: 0.5 };
+    let cmd = DriveCommand::new(1.0, 0.5);
     let Kinematics::DiffDrive(d) = sim.world.get::<Kinematics>(e).unwrap().clone() else {
         unreachable!()
     };
@@ -75,17 +75,17 @@ fn ackermann_drives_an_arc_of_its_steering_angle() {
     let e = sim.robots[0];
     sim.world.entity_mut(e).remove::<Behaviour>();
     // steering saturates at 0.5 rad: radius L / tan(0.5)
-    drive(&mut sim, 0, DriveCommand { v: 1.0, w: 10.0 }, 1);
+    drive(&mut sim, 0, DriveCommand::new(1.0, 10.0), 1);
     let p0 = sim.world.get::<TruePose>(e).unwrap().pose;
-    drive(&mut sim, 0, DriveCommand { v: 1.0, w: 10.0 }, 100);
+    drive(&mut sim, 0, DriveCommand::new(1.0, 10.0), 100);
     let p1 = sim.world.get::<TruePose>(e).unwrap().pose;
     let w = 1.0 * 0.5f64.tan() / 0.35;
     let expected = integrate_arc(&p0, 1.0, w, 100.0 * 0.02);
     assert!(p1.distance(&expected) < 2e-3, "{p1:?} vs {expected:?}");
     // it cannot turn on the spot
-    drive(&mut sim, 0, DriveCommand { v: 0.0, w: 1.0 }, 200);
+    drive(&mut sim, 0, DriveCommand::new(0.0, 1.0), 200);
     let p2 = sim.world.get::<TruePose>(e).unwrap().pose;
-    drive(&mut sim, 0, DriveCommand { v: 0.0, w: 1.0 }, 50);
+    drive(&mut sim, 0, DriveCommand::new(0.0, 1.0), 50);
     let p3 = sim.world.get::<TruePose>(e).unwrap().pose;
     assert!(p2.distance(&p3) < 1e-6 && (p2.theta - p3.theta).abs() < 1e-6);
 }

@@ -154,6 +154,38 @@ fn semantic_errors() {
         "type = \"teleport\"\npose = [1.0, 1.0, 0.0]\nv = 0.3\n",
     ));
     assert!(e.contains("`v` applies to `drive` events only"), "{e}");
+    // a car's speed/steer form
+    let e = scenario_error(&event("type = \"drive\"\nspeed = 0.3\nsteer = 0.1\n"));
+    assert!(
+        e.contains("events[0].steer") && e.contains("has a differential drive"),
+        "{e}"
+    );
+    let car_event = |body: &str| {
+        format!(
+            "{}\n[[events]]\nat = 0.5\nrobot = \"r1\"\n{body}",
+            with_robot("kinematics = { type = \"ackermann\", max_steer = 0.4 }\n")
+        )
+    };
+    let e = scenario_error(&car_event("type = \"drive\"\nspeed = 0.3\nsteer = 0.5\n"));
+    assert!(
+        e.contains("events[0].steer") && e.contains("[-0.4, 0.4]"),
+        "{e}"
+    );
+    let e = scenario_error(&car_event("type = \"drive\"\nspeed = 0.3\n"));
+    assert!(e.contains("needs both `speed` (m/s) and `steer`"), "{e}");
+    let e = scenario_error(&car_event(
+        "type = \"drive\"\nspeed = 0.3\nsteer = 0.1\nw = 0.2\n",
+    ));
+    assert!(
+        e.contains("events[0].w") && e.contains("two forms of a drive event"),
+        "{e}"
+    );
+    let e = scenario_error(&car_event("type = \"release\"\nsteer = 0.1\n"));
+    assert!(e.contains("`steer` applies to `drive` events only"), "{e}");
+    let e = scenario_error(&car_event(
+        "type = \"teleport\"\npose = [1.0, 1.0, 0.0]\nspeed = 0.3\n",
+    ));
+    assert!(e.contains("`speed` applies to `drive` events only"), "{e}");
     let e = scenario_error(&event("type = \"release\"\npose = [1.0, 1.0, 0.0]\n"));
     assert!(
         e.contains("`pose` does not apply to a `release` event"),

@@ -262,6 +262,15 @@ fn bad_requests_are_typed_errors_naming_what_they_concern() {
             known: "r1, r2, r3, r4".into()
         }
     );
+    let r1 = s.robot("r1").unwrap();
+    let e = r1.localizer("amcl").err().unwrap();
+    assert!(
+        matches!(&e, SimError::UnknownLocalizer { robot, name, .. } if robot == "r1" && name == "amcl"),
+        "{e}"
+    );
+    let known: Vec<String> = r1.localizers().iter().map(|l| l.name.to_string()).collect();
+    assert!(e.to_string().contains(&known.join(", ")), "{e}");
+    assert!(r1.localizer(&known[0]).is_ok());
     let nan = Command::Teleport(Pose2::new(f64::NAN, 1.0, 0.0));
     assert!(matches!(
         s.command("r1", nan),
@@ -415,6 +424,131 @@ tasks = [{ type = "go", name = "go_corridor_main_c", to = "corridor_main_c" }]
     );
 }
 
+/// A car in an empty 20 × 20 m yard, wandering, with wheel encoders.
+const CAR_YARD: &str = r#"
+duration = 8.0
+[map]
+resolution = 0.1
+[[walls]]
+from = [0.0, 0.0]
+to = [20.0, 0.0]
+[[walls]]
+from = [0.0, 20.0]
+to = [20.0, 20.0]
+[[walls]]
+from = [0.0, 0.0]
+to = [0.0, 20.0]
+[[walls]]
+from = [20.0, 0.0]
+to = [20.0, 20.0]
+
+[[robots]]
+name = "car"
+start = [10.0, 10.0, 0.0]
+footprint = { circle = 0.3 }
+kinematics = { type = "ackermann", max_steer = 0.45 }
+behaviour = { type = "wander" }
+[robots.sensors.encoder]
+"#;
+
+#[test]
+fn a_speed_steer_command_equals_the_drive_event_in_the_file() {
+    let events = r#"
+[[events]]
+at = 1.0
+type = "drive"
+robot = "car"
+speed = 0.0
+steer = -0.4
+
+[[events]]
+at = 2.0
+type = "drive"
+robot = "car"
+speed = 0.8
+steer = -0.4
+
+[[events]]
+at = 5.0
+type = "release"
+robot = "car"
+"#;
+    let mut file = from_text(&format!("{CAR_YARD}{events}"), "file")
+        .build()
+        .unwrap();
+    let mut scripted = from_text(CAR_YARD, "scripted").build().unwrap();
+    scripted.run_for(1.0).unwrap();
+    let steer = |speed| Command::Steer { speed, steer: -0.4 };
+    scripted.command("car", steer(0.0)).unwrap();
+    scripted.run_for(1.0).unwrap();
+    // standing, the wheels turn and the car stays where it is
+    let car = scripted.robot("car").unwrap();
+    assert!(car.twist().v.abs() < 1e-9, "{:?}", car.twist());
+    scripted.command("car", steer(0.8)).unwrap();
+    scripted.run_for(3.0).unwrap();
+    // rolling on the circle of that angle: ω = v tan(δ) / L (wheelbase 0.35 m), as the
+    // physics step (in f32) moves it
+    let twist = scripted.robot("car").unwrap().twist();
+    let w = 0.8 * (-0.4f64).tan() / 0.35;
+    assert!(
+        (twist.v - 0.8).abs() < 1e-3 && (twist.w - w).abs() < 1e-3,
+        "{twist:?} against ω {w}"
+    );
+    scripted.command("car", Command::Release).unwrap();
+    file.run_for(5.0).unwrap();
+    assert_eq!(fingerprint(&mut file), fingerprint(&mut scripted));
+    let (a, b) = (file.run().unwrap(), scripted.run().unwrap());
+    assert_eq!(summary_json(&a), summary_json(&b));
+    assert!(
+        b.log
+            .iter()
+            .any(|(_, _, what)| what == "drive command held: speed 0.80 m/s, steer -0.400 rad"),
+        "{:?}",
+        b.log
+    );
+}
+
+#[test]
+fn a_speed_steer_command_is_for_cars_within_their_steering_limit() {
+    let mut car = from_text(CAR_YARD, "car").build().unwrap();
+    let e = car
+        .command(
+            "car",
+            Command::Steer {
+                speed: 0.5,
+                steer: 0.5,
+            },
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&e, SimError::BadValue { what, .. } if what == "steering angle of `car`"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("max_steer 0.45"), "{e}");
+    let nan = Command::Steer {
+        speed: f64::NAN,
+        steer: 0.1,
+    };
+    assert!(matches!(
+        car.command("car", nan),
+        Err(SimError::BadValue { .. })
+    ));
+    let mut p = from_text(&patrol_text(), "patrol").build().unwrap();
+    let e = p
+        .command(
+            "r1",
+            Command::Steer {
+                speed: 0.5,
+                steer: 0.1,
+            },
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&e, SimError::NotACar { robot, .. } if robot == "r1"),
+        "{e}"
+    );
+}
+
 #[test]
 fn bad_goals_are_typed_errors() {
     let mut s = from_text(COURIER, "courier").build().unwrap();
@@ -487,4 +621,64 @@ fn a_simulation_writing_files_refuses_to_reset() {
         .unwrap();
     let e = s.reset(2).unwrap_err().to_string();
     assert!(e.contains("writes recordings"), "{e}");
+}
+
+/// Every robot's true pose, each tick, as a program's own Evaluate system saw it.
+#[derive(Resource, Default)]
+struct Watched(Vec<(u64, Entity, Pose2)>);
+
+fn watch(
+    clock: Res<systems::core::SimClock>,
+    robots: Query<(Entity, &systems::body::TruePose), With<systems::core::RobotId>>,
+    mut seen: ResMut<Watched>,
+) {
+    for (e, p) in &robots {
+        seen.0.push((clock.tick, e, p.pose));
+    }
+}
+
+/// A program's own Control system, ordered after held commands: r1 stands still.
+fn hold_r1(mut robots: Query<(&systems::core::RobotId, &mut systems::body::DriveCommand)>) {
+    for (name, mut cmd) in &mut robots {
+        if name.0 == "r1" {
+            *cmd = systems::body::DriveCommand::default();
+        }
+    }
+}
+
+#[test]
+fn a_programs_own_systems_run_in_their_sets() {
+    use systems::core::SimSet;
+    let mut s = Simulation::load("hospital_patrol")
+        .duration(2.0)
+        .threads(2)
+        .build()
+        .unwrap();
+    let start = s.robot("r1").unwrap().pose();
+    let (world, schedule) = s.world_and_schedule();
+    world.init_resource::<Watched>();
+    schedule.add_systems((
+        watch.in_set(SimSet::Evaluate),
+        hold_r1
+            .in_set(SimSet::Control)
+            .after(systems::navigation::held::apply_held_commands),
+    ));
+    s.run_for(1.0).unwrap();
+    let seen = &s.world().resource::<Watched>().0;
+    // four robots, twenty ticks, in tick order
+    assert_eq!(seen.len(), 4 * 20);
+    assert!(seen.windows(2).all(|w| w[0].0 <= w[1].0));
+    let r2 = s.robot("r2").unwrap();
+    let last = seen
+        .iter()
+        .rev()
+        .find(|(_, e, _)| *e == r2.entity())
+        .unwrap();
+    assert_eq!(last.2, r2.pose(), "Evaluate sees the tick's final poses");
+    let r1 = s.robot("r1").unwrap().pose();
+    assert!(
+        r1.distance(&start) < 1e-6,
+        "r1 held still: {r1:?} from {start:?}"
+    );
+    assert!(r2.distance() > 0.1, "r2 drove on");
 }

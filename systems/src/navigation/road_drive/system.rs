@@ -92,7 +92,6 @@ pub fn drive_road_navigators(
             learned: &learned,
         };
         let (v, w) = nav.step(graph, &input);
-        cmd.v = v;
-        cmd.w = w;
+        *cmd = DriveCommand::new(v, w);
     }
 }
