@@ -6,11 +6,10 @@
 //! run spreads by ±25 %.
 
 use crate::Simulation;
-use crate::bench::swarm::{swarm_scenario, swarm_world};
+use crate::bench::swarm::{check_beams, swarm_scenario, swarm_world};
 use serde::Serialize;
 use std::time::{Duration, Instant};
 use systems::core::SimClock;
-use systems::sensors::LaserSpec;
 
 /// `sim bench facade`: a tick through the facade against the bare schedule, paired.
 #[derive(clap::Args, Clone, Debug)]
@@ -62,13 +61,7 @@ pub fn run_facade_bench(o: &FacadeBenchOptions) -> anyhow::Result<()> {
     if let Some(n) = o.robots.iter().find(|n| **n == 0) {
         anyhow::bail!("--robots: expected populations of at least 1 robot, got {n}");
     }
-    let max = LaserSpec::MAX_BEAMS;
-    if !(2..=max).contains(&o.beams) {
-        anyhow::bail!(
-            "--beams: expected 2 to {max} beams per scan, got {}",
-            o.beams
-        );
-    }
+    check_beams(o.beams)?;
     let grid = swarm_world()?;
     if !o.json {
         println!(

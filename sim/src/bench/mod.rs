@@ -6,6 +6,7 @@ pub mod facade;
 pub mod localization;
 pub mod machine;
 pub mod matching;
+pub mod profile;
 pub mod record;
 pub mod slam;
 pub mod swarm;

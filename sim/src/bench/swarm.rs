@@ -183,6 +183,15 @@ pub fn swarm_scenario(
     })
 }
 
+/// A `--beams` value: 2 to [`LaserSpec::MAX_BEAMS`] beams per scan.
+pub fn check_beams(beams: usize) -> anyhow::Result<()> {
+    let max = LaserSpec::MAX_BEAMS;
+    if !(2..=max).contains(&beams) {
+        anyhow::bail!("--beams: expected 2 to {max} beams per scan, got {beams}");
+    }
+    Ok(())
+}
+
 /// The benchmark world: the hospital tiled 4 × 4.
 pub fn swarm_world() -> anyhow::Result<OccupancyGrid> {
     let path = assets_dir().join("maps/hospital/hospital.yaml");
@@ -195,9 +204,8 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     if let Some(n) = o.robots.iter().find(|n| **n == 0) {
         anyhow::bail!("--robots: expected populations of at least 1 robot, got {n}");
     }
-    let max = LaserSpec::MAX_BEAMS;
-    if let Some(b) = o.beams.iter().find(|b| !(2..=max).contains(*b)) {
-        anyhow::bail!("--beams: expected 2 to {max} beams per scan, got {b}");
+    for &b in &o.beams {
+        check_beams(b)?;
     }
     let grid = swarm_world()?;
     // every population is placed before the first one runs, so one that does not fit fails

@@ -15,6 +15,8 @@ pub enum BenchCommand {
     /// A tick through the library facade against the bare schedule, alternating on one world:
     /// the median of the paired differences.
     Facade(bench::facade::FacadeBenchOptions),
+    /// Where a tick's time goes: each system's time per tick and share, on one thread.
+    Profile(bench::profile::ProfileOptions),
     /// Real-time factor and time per scan of each SLAM mode on the hospital loop run.
     Slam(bench::slam::SlamBenchOptions),
     /// DE scan-matching time per alignment of 1081-beam hospital scans (one core).
@@ -33,6 +35,7 @@ pub fn bench_command(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Batch(a) => bench::batch::run_batch_bench(&a).map(drop),
         BenchCommand::Swarm(o) => bench::swarm::run_swarm_bench(&o),
         BenchCommand::Facade(o) => bench::facade::run_facade_bench(&o),
+        BenchCommand::Profile(o) => bench::profile::run_profile(&o),
         BenchCommand::Slam(o) => bench::slam::run_slam_bench(&o).map(drop),
         BenchCommand::DeMatch(o) => bench::matching::run_de_match_bench(&o),
         BenchCommand::Mcl(o) => bench::localization::run_mcl_bench(&o),
