@@ -177,6 +177,7 @@ pub fn build_world_with(
     if let Some(maps) = costmaps {
         world.insert_resource(maps);
     }
+    physics.prepare();
     world.insert_resource(physics);
     world.insert_resource(EventQueue::new(
         scenario.events.clone(),

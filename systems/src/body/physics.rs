@@ -125,6 +125,16 @@ impl Physics {
         physics
     }
 
+    /// Builds the broad phase over every collider (the map's, the robots', the people's) and
+    /// finds the first contacts, which the first step would otherwise do inside the run (about
+    /// 11 ms for the hospital tiled 4 × 4). Contacts found here count as the first step's would.
+    pub fn prepare(&mut self) {
+        let events = std::mem::take(&mut self.events);
+        self.world.detect_collisions(&(), &events);
+        self.events = events;
+        self.count_events();
+    }
+
     /// Number of static colliders.
     pub fn static_collider_count(&self) -> usize {
         self.tile_colliders.iter().map(Vec::len).sum()
@@ -393,6 +403,64 @@ pub fn collisions_of(physics: &Physics, index: &RobotIndex) -> Collisions {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A room of 10 × 10 m walls with a robot starting against the east wall and one in the
+    /// middle, both driven east for three seconds; each body's path and the collision counts.
+    fn drive_east(prepared: bool) -> (Vec<[u32; 3]>, Vec<Collisions>) {
+        use crate::world::{Cell, OccupancyGrid};
+        let mut grid = OccupancyGrid::new(100, 100, 0.1, [0.0, 0.0], Cell::Free);
+        for i in 0..100 {
+            for (c, r) in [(i, 0), (i, 99), (0, i), (99, i)] {
+                grid.set(c, r, Cell::Occupied);
+            }
+        }
+        let mut ground = StaticWorld::new(grid);
+        let mut physics = Physics::new(&mut ground, 0.05);
+        let circle = Footprint::Circle { radius: 0.25 };
+        // the wall's face is at x = 9.9: the first robot overlaps it by a centimetre
+        let bodies = [
+            physics.add_robot(0, &Pose2::new(9.66, 5.0, 0.0), &circle),
+            physics.add_robot(1, &Pose2::new(6.0, 3.0, 0.3), &circle),
+        ];
+        if prepared {
+            physics.prepare();
+        }
+        let mut path = Vec::new();
+        for _ in 0..60 {
+            for b in &bodies {
+                let body = physics.world.bodies.get_mut(b.0).unwrap();
+                body.set_linvel(Vector::new(2.0, 0.1), true);
+                body.set_angvel(0.2, true);
+            }
+            let events = std::mem::take(&mut physics.events);
+            physics.world.step_with_events(&(), &events);
+            physics.events = events;
+            physics.count_events();
+            for b in &bodies {
+                let body = &physics.world.bodies[b.0];
+                let t = body.translation();
+                path.push([
+                    t.x.to_bits(),
+                    t.y.to_bits(),
+                    body.rotation().angle().to_bits(),
+                ]);
+            }
+        }
+        (path, vec![physics.collisions(0), physics.collisions(1)])
+    }
+
+    /// Building the broad phase and the first contacts before the first step changes nothing
+    /// that follows, to the bit, contacts at the start included.
+    #[test]
+    fn a_prepared_world_steps_exactly_as_an_unprepared_one() {
+        let (plain, plain_hits) = drive_east(false);
+        let (prepared, prepared_hits) = drive_east(true);
+        assert_eq!(plain_hits, prepared_hits);
+        // both robots reached the east wall
+        assert_eq!(plain_hits[0].wall, 1, "{plain_hits:?}");
+        assert_eq!(plain_hits[1].wall, 1, "{plain_hits:?}");
+        assert_eq!(plain, prepared);
+    }
 
     /// Widening the skin leaves every length the solver derives from the length unit as it was,
     /// to the bit (so contacts, tolerances and velocity caps do not change with it).
