@@ -12,20 +12,37 @@ use systems::navigation::{Goal, Task, TaskKind};
 pub enum Command {
     /// A new route for a robot driven by a behaviour (followed once, or round and round).
     Waypoints {
+        /// The route's points (m), in order.
         points: Vec<[f64; 2]>,
+        /// Back to the first point after the last, for ever.
         looping: bool,
     },
     /// Moves the robot to `pose` without telling its estimators (a kidnapping).
     Teleport(Pose2),
     /// A sensor stops (`active`) or resumes producing readings.
-    SensorFault { sensor: SensorName, active: bool },
+    SensorFault {
+        /// Which of the robot's sensors.
+        sensor: SensorName,
+        /// True: the fault starts (the sensor is silent); false: it ends.
+        active: bool,
+    },
     /// A velocity command (forward m/s, yaw rate rad/s; an Ackermann robot steers to that yaw
     /// rate) held until replaced or released; the robot's limits still apply.
-    Drive { v: f64, w: f64 },
+    Drive {
+        /// Forward speed (m/s).
+        v: f64,
+        /// Yaw rate (rad/s).
+        w: f64,
+    },
     /// A car's (Ackermann robot's) command in its own terms: forward speed (m/s) and steering
     /// angle (rad, within the car's `max_steer`), held like [`Command::Drive`]. The wheels turn to
     /// the angle at the car's steering rate, also at a standstill.
-    Steer { speed: f64, steer: f64 },
+    Steer {
+        /// Forward speed (m/s).
+        speed: f64,
+        /// Steering angle (rad), positive to the left.
+        steer: f64,
+    },
     /// Drops the held velocity command: the behaviour or navigator drives again.
     Release,
     /// Sends a navigating robot (one with tasks) to a place or a point: a `go` task appended
@@ -44,49 +61,115 @@ pub enum Target {
     Point([f64; 2]),
 }
 
-/// Why the facade refused a request.
+/// Why the facade refused a request. `known` fields list the names that would have been
+/// accepted, comma-separated (`none` when there are none).
 #[derive(Clone, Debug, thiserror::Error, PartialEq)]
 pub enum SimError {
+    /// A robot name that is not the scenario's.
     #[error("no robot named `{name}` (robots: {known})")]
-    UnknownRobot { name: String, known: String },
-    #[error("robot `{robot}` has no localizer or SLAM system named `{name}` (it has: {known})")]
-    UnknownLocalizer {
-        robot: String,
+    UnknownRobot {
+        /// The name asked for.
         name: String,
+        /// The scenario's robots.
         known: String,
     },
+    /// A localizer or SLAM name that the robot does not have.
+    #[error("robot `{robot}` has no localizer or SLAM system named `{name}` (it has: {known})")]
+    UnknownLocalizer {
+        /// The robot.
+        robot: String,
+        /// The name asked for.
+        name: String,
+        /// The robot's localizers and SLAM systems.
+        known: String,
+    },
+    /// A door name that the map's places file does not define.
     #[error("no door named `{name}` (doors: {known})")]
-    UnknownDoor { name: String, known: String },
+    UnknownDoor {
+        /// The name asked for.
+        name: String,
+        /// The map's doors.
+        known: String,
+    },
+    /// A sensor fault for a sensor the robot does not carry.
     #[error("robot `{robot}` has no {sensor}")]
-    NoSuchSensor { robot: String, sensor: String },
+    NoSuchSensor {
+        /// The robot.
+        robot: String,
+        /// The sensor (laser, encoder, sonar).
+        sensor: String,
+    },
+    /// A car's command ([`Command::Steer`]) for a differential drive.
     #[error("robot `{robot}` has a differential drive; {what} drives a car (Ackermann)")]
-    NotACar { robot: String, what: &'static str },
+    NotACar {
+        /// The robot.
+        robot: String,
+        /// The command.
+        what: &'static str,
+    },
+    /// Waypoints for a robot that follows navigation tasks.
     #[error("robot `{robot}` follows navigation tasks, not waypoints")]
-    NotOnWaypoints { robot: String },
+    NotOnWaypoints {
+        /// The robot.
+        robot: String,
+    },
+    /// A goal or tasks for a robot without a task queue.
     #[error("robot `{robot}` has no task queue (a robot with `[[robots.tasks]]` takes tasks)")]
-    NotNavigating { robot: String },
+    NotNavigating {
+        /// The robot.
+        robot: String,
+    },
+    /// A place name that the map's places file does not define.
     #[error("no place named `{name}` (places: {known})")]
-    UnknownPlace { name: String, known: String },
+    UnknownPlace {
+        /// The name asked for.
+        name: String,
+        /// The map's places.
+        known: String,
+    },
+    /// A number out of its range: NaN or infinite, negative where it cannot be, an empty list.
     #[error("{what}: expected {expected}, got {got}")]
     BadValue {
+        /// What the value is (names the robot).
         what: String,
+        /// What was expected.
         expected: &'static str,
+        /// What was given.
         got: String,
     },
+    /// A pose or goal where the robot's footprint would overlap an obstacle.
     #[error("{what} ({x}, {y}) would place the robot inside an obstacle")]
-    InsideObstacle { what: String, x: f64, y: f64 },
+    InsideObstacle {
+        /// What the point is (names the robot).
+        what: String,
+        /// The point (m).
+        x: f64,
+        /// The point (m).
+        y: f64,
+    },
+    /// A user controller panicked or returned a non-finite command; the simulation does not
+    /// step any further, and can still be finished.
     #[error("the controller of robot `{robot}` {what} at tick {tick} (t = {time} s)")]
     ControllerFailed {
+        /// The robot the controller drove.
         robot: String,
+        /// The tick it failed at.
         tick: u64,
+        /// Simulated time at the start of that tick (s).
         time: f64,
+        /// What it did: the panic's message, or the command it returned.
         what: String,
     },
+    /// A point outside the map's bounds.
     #[error("{what} ({x}, {y}) is outside the map ({bounds})")]
     OutsideMap {
+        /// What the point is (names the robot).
         what: String,
+        /// The point (m).
         x: f64,
+        /// The point (m).
         y: f64,
+        /// The map's bounds.
         bounds: String,
     },
 }

@@ -31,6 +31,7 @@ pub struct Observation<'w> {
 /// an Ackermann robot steers to that yaw rate) per tick. The robot's kinematic limits apply
 /// to it as to every command. A closure `FnMut(&Observation) -> Twist` is a controller.
 pub trait Controller: Send + Sync + 'static {
+    /// The command for this tick, from what the robot senses (`observation`).
     fn control(&mut self, observation: &Observation) -> Twist;
 }
 

@@ -25,8 +25,11 @@ pub struct RunExports {
 /// What was exported.
 #[derive(Clone, Debug, Default)]
 pub struct Exported {
+    /// The CARMEN logs written, one per exported robot.
     pub carmen_logs: Vec<PathBuf>,
+    /// The maps saved (known-pose maps and SLAM maps).
     pub maps: Vec<SavedMap>,
+    /// The MCAP replay, if one was written.
     pub mcap: Option<McapWritten>,
 }
 

@@ -35,5 +35,6 @@ pub fn requested() -> bool {
 #[derive(Debug, thiserror::Error)]
 #[error("interrupted at t = {sim_time_s:.2} s (files written for the partial run)")]
 pub struct Interrupted {
+    /// Simulated time when the run stopped (s).
     pub sim_time_s: f64,
 }

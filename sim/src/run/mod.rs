@@ -5,6 +5,9 @@
 //! the recordings and exports are then finished as after the last tick, and the summary covers
 //! the ticks run.
 
+// the library facade and what it returns: every public item is documented
+#![warn(missing_docs)]
+
 mod attach;
 pub mod capture;
 pub mod command;
@@ -40,6 +43,7 @@ pub use view::{
     DoorView, Estimate, LocalizerView, NavigationView, PersonView, RobotView, ScanView, Twist,
 };
 
+/// How [`run_scenario`] runs a scenario (the options of `sim run` that are not files).
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
     /// Write the .rrd here (None: no recording).
@@ -52,7 +56,9 @@ pub struct RunOptions {
     pub trajectory_period: Option<f64>,
 }
 
+/// What [`run_scenario`] leaves.
 pub struct RunOutput {
+    /// What `--summary` writes.
     pub summary: Summary,
     /// (time, true pose of each robot in index order), if requested.
     pub trajectory: Vec<(f64, Vec<Pose2>)>,

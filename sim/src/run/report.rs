@@ -72,11 +72,15 @@ fn write_file(p: &Path, what: &str, text: String) -> anyhow::Result<()> {
 
 /// What to print and write after a run or a replay.
 pub struct RunReport<'a> {
+    /// Print nothing but errors.
     pub quiet: bool,
     /// The recording written.
     pub rrd: Option<&'a Path>,
+    /// Where to write the trajectories (TUM files, a folder).
     pub trajectories: Option<&'a Path>,
+    /// Where to write the summary (JSON).
     pub summary: Option<&'a Path>,
+    /// Where to write the event log.
     pub log: Option<&'a Path>,
 }
 

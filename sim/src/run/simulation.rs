@@ -57,10 +57,13 @@ pub struct Simulation {
 /// What a finished simulation leaves: its summary (what `--summary` writes), every robot's
 /// estimates beside the truth, the event log and the files exported.
 pub struct Finished {
+    /// What `--summary` writes.
     pub summary: Summary,
+    /// Every robot's localizer estimates beside its true poses, in robot order.
     pub localization: Vec<RobotLocalization>,
     /// Scenario and navigation events in time order: (time, robot or "" for the world, text).
     pub log: Vec<(f64, String, String)>,
+    /// The files exported (CARMEN logs, maps, the MCAP replay).
     pub exported: Exported,
 }
 

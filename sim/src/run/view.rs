@@ -22,7 +22,9 @@ use systems::sensors::{
 /// A robot's linear and angular velocity (m/s, rad/s).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Twist {
+    /// Forward speed (m/s).
     pub v: f64,
+    /// Yaw rate (rad/s).
     pub w: f64,
 }
 
@@ -182,6 +184,7 @@ impl<'w> ScanView<'w> {
         self.scan
     }
 
+    /// The ranges (m), beam by beam from the first angle; +Inf for no return.
     pub fn ranges(&self) -> &'w [f32] {
         &self.scan.ranges
     }
@@ -220,7 +223,9 @@ impl<'w> ScanView<'w> {
 pub struct Estimate {
     /// The time of the data it comes from (s).
     pub stamp: f64,
+    /// The estimated pose (map frame).
     pub pose: Pose2,
+    /// Its covariance over (x, y, θ) (m², rad²).
     pub covariance: [[f64; 3]; 3],
 }
 
@@ -310,6 +315,8 @@ impl<'w> NavigationView<'w> {
 /// A door of the world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DoorView {
+    /// Its name in the map's places file.
     pub name: String,
+    /// Open (passable) or closed.
     pub open: bool,
 }

@@ -7,34 +7,49 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use systems::eval::LocalizerMetrics;
 
+/// A run's results, as `--summary` writes them.
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct Summary {
+    /// The scenario's name.
     pub scenario: String,
+    /// The run's seed.
     pub seed: u64,
+    /// Simulated time run (s).
     pub sim_time_s: f64,
+    /// Wall-clock time from the first tick to the last (s).
     pub wall_time_s: f64,
+    /// Simulated over wall-clock time.
     pub real_time_factor: f64,
+    /// Each robot, in scenario order.
     pub robots: Vec<RobotSummary>,
 }
 
+/// One robot's results.
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct RobotSummary {
+    /// The robot's name.
     pub name: String,
     /// Ground-truth distance driven (m).
     pub distance_m: f64,
     /// Contact starts with walls, other robots and walking people.
     pub collisions: u32,
+    /// Of those, with walls.
     pub wall_collisions: u32,
+    /// Of those, with other robots.
     pub robot_collisions: u32,
+    /// Of those, with walking people.
     pub person_collisions: u32,
     /// Final wheel-odometry position error (m).
     pub odometry_drift_m: f64,
+    /// Largest wheel-odometry position error during the run (m).
     pub max_odometry_drift_m: f64,
     /// RMSE of the wheel odometry's position error over the run (its ATE, m).
     pub odometry_ate_m: f64,
     /// Final drift per distance driven (%).
     pub odometry_drift_percent: f64,
+    /// Final wheel-odometry heading error (rad).
     pub odometry_heading_error_rad: f64,
+    /// Waypoints of its route reached (counted again on each loop).
     pub waypoints_reached: u32,
     /// The robot's route ended at its goal: the last waypoint of a waypoint route, or the goal
     /// node of a road route.
@@ -51,16 +66,22 @@ pub struct RobotSummary {
     pub road: Option<crate::run::summary::road::RoadSummary>,
 }
 
+/// A navigating robot's tasks and how they went.
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct NavigationSummary {
+    /// Tasks given (at the start and by events or commands).
     pub tasks: u32,
+    /// Tasks done.
     pub tasks_completed: u32,
+    /// Tasks given up.
     pub tasks_failed: u32,
     /// Every task done or failed.
     pub all_tasks_done: bool,
+    /// Delivery tasks done.
     pub deliveries_completed: u32,
     /// Each completed delivery, from taking the task to the end of unloading (s).
     pub delivery_times_s: Vec<f64>,
+    /// Their mean (s); None without a completed delivery.
     pub mean_delivery_time_s: Option<f64>,
     /// Legs (drives to a goal) completed.
     pub legs: u32,
@@ -72,20 +93,28 @@ pub struct NavigationSummary {
     pub path_ratio: Option<f64>,
     /// Contact starts with walls and with other robots during the run.
     pub collisions: u32,
+    /// Of those, with walls.
     pub wall_collisions: u32,
-    /// Stops for obstacles, and the time spent stopped or waiting aside (s).
+    /// Stops for obstacles.
     pub stops: u32,
+    /// Time spent stopped or waiting aside (s).
     pub waiting_time_s: f64,
+    /// Routes planned again (a blocked path, a door closed, a robot in the way).
     pub replans: u32,
     /// Times the robot gave way to another robot.
     pub yields: u32,
+    /// Each failed task, with why.
     pub failures: Vec<NavigationFailure>,
 }
 
+/// A task given up.
 #[derive(Serialize, Clone, Debug, PartialEq)]
 pub struct NavigationFailure {
+    /// When (simulated s).
     pub time_s: f64,
+    /// The task's name.
     pub task: String,
+    /// Why.
     pub reason: String,
 }
 
