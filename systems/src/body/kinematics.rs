@@ -237,16 +237,21 @@ mod tests {
         assert!((v - 1.0).abs() < 1e-12);
     }
 
-    #[test]
-    fn ackermann_cannot_turn_on_the_spot() {
-        let k = Kinematics::Ackermann(Ackermann {
+    /// A 0.35 m car steering at most 0.5 rad at 1 rad/s, up to 2 m/s.
+    fn small_car() -> Ackermann {
+        Ackermann {
             wheelbase: 0.35,
             max_steer: 0.5,
             max_steer_rate: 1.0,
             max_speed: 2.0,
             max_accel: 100.0,
             wheel_radius: 0.05,
-        });
+        }
+    }
+
+    #[test]
+    fn ackermann_cannot_turn_on_the_spot() {
+        let k = Kinematics::Ackermann(small_car());
         let mut s = DriveState::default();
         let (v, w) = k.step(&DriveCommand::new(0.0, 1.0), &mut s, 0.1);
         assert_eq!((v, w), (0.0, 0.0));
@@ -264,14 +269,7 @@ mod tests {
 
     #[test]
     fn a_speed_steer_command_steers_at_a_standstill_and_holds_its_angle() {
-        let car = Ackermann {
-            wheelbase: 0.35,
-            max_steer: 0.5,
-            max_steer_rate: 1.0,
-            max_speed: 2.0,
-            max_accel: 100.0,
-            wheel_radius: 0.05,
-        };
+        let car = small_car();
         let k = Kinematics::Ackermann(car.clone());
         let mut s = DriveState::default();
         // standing: the wheels turn (at the steering rate), the car does not

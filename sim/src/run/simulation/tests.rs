@@ -3,7 +3,7 @@
 //! it concerns.
 
 use super::*;
-use crate::run::{RunOptions, Target, run_scenario};
+use crate::run::{Command, RunOptions, Target, run_scenario};
 use crate::scenario::{SensorName, assets_dir, find_scenario};
 use systems::core::Pose2;
 
