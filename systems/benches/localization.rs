@@ -7,7 +7,9 @@
 //! - `mcl_field_kernel_5000/{best,scalar}`: its scoring loop, vectorised against scalar;
 //! - `markov_grid_update/selective`: a Markov grid update (0.25 m × 10°) once converged;
 //!   `markov_grid_update/global`: with every cell scored (selective update off);
-//! - `de_filter_update`: a DE filter update (population 2 000, global start).
+//! - `de_filter_update`: a DE filter update (population 2 000, global start);
+//! - `cluster/{dense,plain}/<n>`: the dominant-cluster estimate of n particles spread over the
+//!   whole floor (a global filter's first estimates), dense histogram against hash map.
 //!
 //! The filter is rebuilt when the drive runs out, so every update follows a real motion.
 
@@ -170,6 +172,31 @@ fn de_filter(c: &mut Criterion, map: &LocalizationMap, steps: &[DriveStep], beam
     g.finish();
 }
 
+fn cluster(c: &mut Criterion, map: &LocalizationMap) {
+    use rand::RngExt;
+    use systems::localization::mcl::{BinSize, cluster};
+    let mut g = c.benchmark_group("cluster");
+    for n in [5_000usize, 100_000] {
+        let mut rng = stream_rng(1, "bench", "cluster");
+        let (mut xs, mut ys, mut ths) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..n {
+            let (x, y, th) = map.random_free_pose(&mut || rng.random::<f64>());
+            xs.push(x);
+            ys.push(y);
+            ths.push(th);
+        }
+        let w = vec![1.0 / n as f64; n];
+        let bins = BinSize::default();
+        g.bench_with_input(BenchmarkId::new("dense", n), &n, |b, _| {
+            b.iter(|| black_box(cluster::dominant_cluster(&xs, &ys, &ths, &w, &bins)))
+        });
+        g.bench_with_input(BenchmarkId::new("plain", n), &n, |b, _| {
+            b.iter(|| black_box(cluster::dominant_cluster_plain(&xs, &ys, &ths, &w, &bins)))
+        });
+    }
+    g.finish();
+}
+
 fn localization(c: &mut Criterion) {
     let map = hospital();
     let steps = recorded_drive(&map, &CORRIDOR, 0.0, 1);
@@ -177,6 +204,7 @@ fn localization(c: &mut Criterion) {
     mcl(c, &map, &steps, &beams);
     markov_grid(c, &map, &steps, &beams);
     de_filter(c, &map, &steps, &beams);
+    cluster(c, &map);
 }
 
 criterion_group! {

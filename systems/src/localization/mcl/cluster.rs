@@ -25,6 +25,272 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
     i
 }
 
+/// Joins the sets of bins `a` and `b`, the smaller root under the larger: the plain version,
+/// whose roots are each set's smallest bin number whatever order bins are joined in.
+fn union_min(parent: &mut [usize], a: usize, b: usize) {
+    let (a, b) = (find(parent, a), find(parent, b));
+    if a != b {
+        parent[a.max(b)] = a.min(b);
+    }
+}
+
+/// Disjoint sets joined by size (shallow trees: the plain rule chains bins numbered in
+/// random spatial order into long paths), labelled at the end with each set's smallest
+/// member, the same roots as [`union_min`] gives.
+struct SizedSets {
+    parent: Vec<usize>,
+    size: Vec<u32>,
+}
+
+impl SizedSets {
+    fn new(n: usize) -> Self {
+        SizedSets {
+            parent: (0..n).collect(),
+            size: vec![1; n],
+        }
+    }
+
+    fn union(&mut self, a: usize, b: usize) {
+        let (a, b) = (find(&mut self.parent, a), find(&mut self.parent, b));
+        if a == b {
+            return;
+        }
+        let (big, small) = if self.size[a] >= self.size[b] {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        self.parent[small] = big;
+        self.size[big] += self.size[small];
+    }
+
+    /// Each member's set, named by the set's smallest member.
+    fn smallest_members(mut self) -> Vec<usize> {
+        let n = self.parent.len();
+        let mut smallest = vec![usize::MAX; n];
+        let mut roots = Vec::with_capacity(n);
+        for i in 0..n {
+            let r = find(&mut self.parent, i);
+            if smallest[r] == usize::MAX {
+                // members are visited in increasing order: the first one seen is the smallest
+                smallest[r] = i;
+            }
+            roots.push(smallest[r]);
+        }
+        roots
+    }
+}
+
+/// Bins numbered in the order particles first fall into them: each particle's bin number and
+/// each bin's key (heading bin wrapped into `0..theta_bins`).
+struct Bins {
+    of_particle: Vec<usize>,
+    keys: Vec<(i32, i32, i32)>,
+}
+
+/// The half of the 26 neighbour offsets that is lexicographically after (0, 0, 0): every pair
+/// of touching bins is one bin plus one of these.
+const FORWARD: [(i32, i32, i32); 13] = [
+    (0, 0, 1),
+    (0, 1, -1),
+    (0, 1, 0),
+    (0, 1, 1),
+    (1, -1, -1),
+    (1, -1, 0),
+    (1, -1, 1),
+    (1, 0, -1),
+    (1, 0, 0),
+    (1, 0, 1),
+    (1, 1, -1),
+    (1, 1, 0),
+    (1, 1, 1),
+];
+
+/// Cells a dense histogram may have per particle before the hash map is used instead: a
+/// global filter covers the map's box densely, a tracking one a few bins around the robot.
+const DENSE_CELLS_PER_PARTICLE: usize = 64;
+const DENSE_CELLS_MIN: usize = 1 << 16;
+
+/// A histogram over the bounding box of the keys, padded by one bin in x and y so that
+/// neighbours need no bounds checks; headings wrap. None when the box is too sparse.
+struct DenseBins {
+    cells: Vec<u32>,
+    x0: i32,
+    y0: i32,
+    row: usize,
+    theta_bins: usize,
+}
+
+impl DenseBins {
+    fn new(keys: &[(i32, i32, i32)], theta_bins: i32) -> Option<Self> {
+        let (mut x0, mut x1, mut y0, mut y1) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+        for &(kx, ky, _) in keys {
+            (x0, x1, y0, y1) = (x0.min(kx), x1.max(kx), y0.min(ky), y1.max(ky));
+        }
+        let width = (x1 as i64 - x0 as i64 + 3) as usize;
+        let height = (y1 as i64 - y0 as i64 + 3) as usize;
+        let theta_bins = theta_bins as usize;
+        let limit = (keys.len() * DENSE_CELLS_PER_PARTICLE).max(DENSE_CELLS_MIN);
+        let cells = width.checked_mul(height)?.checked_mul(theta_bins)?;
+        (cells <= limit).then(|| DenseBins {
+            cells: vec![u32::MAX; cells],
+            x0: x0 - 1,
+            y0: y0 - 1,
+            row: width,
+            theta_bins,
+        })
+    }
+
+    fn index(&self, (kx, ky, kt): (i32, i32, i32)) -> usize {
+        let (x, y) = ((kx - self.x0) as usize, (ky - self.y0) as usize);
+        (y * self.row + x) * self.theta_bins + kt as usize
+    }
+}
+
+fn bin_particles(keys: &[(i32, i32, i32)], dense: Option<&mut DenseBins>) -> Bins {
+    let mut bins = Bins {
+        of_particle: Vec::with_capacity(keys.len()),
+        keys: Vec::new(),
+    };
+    match dense {
+        Some(grid) => {
+            for &key in keys {
+                let cell = grid.index(key);
+                if grid.cells[cell] == u32::MAX {
+                    grid.cells[cell] = bins.keys.len() as u32;
+                    bins.keys.push(key);
+                }
+                bins.of_particle.push(grid.cells[cell] as usize);
+            }
+        }
+        None => {
+            let mut ids: FxHashMap<(i32, i32, i32), usize> = FxHashMap::default();
+            for &key in keys {
+                let id = *ids.entry(key).or_insert_with(|| {
+                    bins.keys.push(key);
+                    bins.keys.len() - 1
+                });
+                bins.of_particle.push(id);
+            }
+        }
+    }
+    bins
+}
+
+/// Each bin's cluster root (the smallest bin number of its cluster), neighbours looked up in
+/// `dense`, the histogram `bin_particles` filled, or else in a hash map.
+fn cluster_roots(
+    bin_keys: &[(i32, i32, i32)],
+    theta_bins: i32,
+    dense: Option<&DenseBins>,
+) -> Vec<usize> {
+    let mut sets = SizedSets::new(bin_keys.len());
+    match dense {
+        Some(grid) => return dense_cluster_roots(grid, bin_keys.len()),
+        None => {
+            let ids = bin_ids(bin_keys);
+            for (id, &key) in bin_keys.iter().enumerate() {
+                for offset in FORWARD {
+                    if let Some(&other) = ids.get(&neighbour(key, offset, theta_bins)) {
+                        sets.union(id, other);
+                    }
+                }
+            }
+        }
+    }
+    sets.smallest_members()
+}
+
+/// [`cluster_roots`] over the dense histogram. The bins are joined in the histogram's memory
+/// order under labels given in that order, so neighbouring bins have nearby labels and the
+/// sets' arrays are read almost in sequence (bin numbers, given in particle order, are
+/// scattered over the floor).
+fn dense_cluster_roots(grid: &DenseBins, bins: usize) -> Vec<usize> {
+    let mut label_of_bin = vec![0u32; bins];
+    let mut labels = vec![u32::MAX; grid.cells.len()];
+    let mut next = 0;
+    for (cell, &id) in grid.cells.iter().enumerate() {
+        if id != u32::MAX {
+            label_of_bin[id as usize] = next;
+            labels[cell] = next;
+            next += 1;
+        }
+    }
+    let t_bins = grid.theta_bins;
+    let mut sets = SizedSets::new(bins);
+    // each forward offset as a shift of the (x, y) column in the histogram, and the heading step
+    let shifts = FORWARD.map(|(dx, dy, dt)| {
+        let columns = dy as isize * grid.row as isize + dx as isize;
+        (columns * t_bins as isize, dt)
+    });
+    for (column, cells) in labels.chunks_exact(t_bins).enumerate() {
+        let start = (column * t_bins) as isize;
+        for (t, &label) in cells.iter().enumerate() {
+            if label == u32::MAX {
+                continue;
+            }
+            for (shift, dt) in shifts {
+                // the heading wraps: one step below 0 is the last bin, one above it the first
+                let tt = match t as isize + dt as isize {
+                    -1 => t_bins - 1,
+                    tt if tt as usize == t_bins => 0,
+                    tt => tt as usize,
+                };
+                let other = labels[(start + shift) as usize + tt];
+                if other != u32::MAX {
+                    sets.union(label as usize, other as usize);
+                }
+            }
+        }
+    }
+    // each bin's set, named by the set's smallest bin number (bins visited in increasing order)
+    let mut smallest = vec![usize::MAX; bins];
+    (0..bins)
+        .map(|id| {
+            let r = find(&mut sets.parent, label_of_bin[id] as usize);
+            if smallest[r] == usize::MAX {
+                smallest[r] = id;
+            }
+            smallest[r]
+        })
+        .collect()
+}
+
+/// The plain version of [`cluster_roots`]: every one of the 26 neighbours looked up in a hash
+/// map, sets joined under their smallest root.
+fn cluster_roots_plain(bin_keys: &[(i32, i32, i32)], theta_bins: i32) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..bin_keys.len()).collect();
+    let ids = bin_ids(bin_keys);
+    for (id, &key) in bin_keys.iter().enumerate() {
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dt in -1..=1 {
+                    if let Some(&other) = ids.get(&neighbour(key, (dx, dy, dt), theta_bins)) {
+                        union_min(&mut parent, id, other);
+                    }
+                }
+            }
+        }
+    }
+    (0..bin_keys.len()).map(|i| find(&mut parent, i)).collect()
+}
+
+fn bin_ids(bin_keys: &[(i32, i32, i32)]) -> FxHashMap<(i32, i32, i32), usize> {
+    bin_keys
+        .iter()
+        .enumerate()
+        .map(|(id, &key)| (key, id))
+        .collect()
+}
+
+fn neighbour(
+    (kx, ky, kt): (i32, i32, i32),
+    (dx, dy, dt): (i32, i32, i32),
+    theta_bins: i32,
+) -> (i32, i32, i32) {
+    (kx + dx, ky + dy, (kt + dt).rem_euclid(theta_bins))
+}
+
 /// The dominant cluster's estimate; None for an empty set.
 pub fn dominant_cluster(
     xs: &[f64],
@@ -33,39 +299,50 @@ pub fn dominant_cluster(
     w: &[f64],
     bins: &BinSize,
 ) -> Option<PoseEstimate> {
+    dominant_cluster_with(xs, ys, ths, w, bins, true)
+}
+
+/// [`dominant_cluster`] as first written: bins and all 26 neighbours looked up in a hash map,
+/// sets joined under their smallest root. The plain version the tests and the `cluster`
+/// benchmark compare the fast one with.
+pub fn dominant_cluster_plain(
+    xs: &[f64],
+    ys: &[f64],
+    ths: &[f64],
+    w: &[f64],
+    bins: &BinSize,
+) -> Option<PoseEstimate> {
+    dominant_cluster_with(xs, ys, ths, w, bins, false)
+}
+
+fn dominant_cluster_with(
+    xs: &[f64],
+    ys: &[f64],
+    ths: &[f64],
+    w: &[f64],
+    bins: &BinSize,
+    fast: bool,
+) -> Option<PoseEstimate> {
     if w.is_empty() {
         return None;
     }
     let theta_bins = ((std::f64::consts::TAU / bins.theta).round() as i32).max(1);
-    let mut ids: FxHashMap<(i32, i32, i32), usize> = FxHashMap::default();
-    let mut keys = Vec::new();
-    let mut particle_bin = Vec::with_capacity(w.len());
-    for i in 0..w.len() {
-        let (kx, ky, kt) = bins.key(xs[i], ys[i], ths[i]);
-        let key = (kx, ky, kt.rem_euclid(theta_bins));
-        let id = *ids.entry(key).or_insert_with(|| {
-            keys.push(key);
-            keys.len() - 1
-        });
-        particle_bin.push(id);
-    }
-    let mut parent: Vec<usize> = (0..keys.len()).collect();
-    for (id, &(kx, ky, kt)) in keys.iter().enumerate() {
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dt in -1..=1 {
-                    let nk = (kx + dx, ky + dy, (kt + dt).rem_euclid(theta_bins));
-                    if let Some(&other) = ids.get(&nk) {
-                        let (a, b) = (find(&mut parent, id), find(&mut parent, other));
-                        if a != b {
-                            parent[a.max(b)] = a.min(b);
-                        }
-                    }
-                }
-            }
-        }
-    }
-    let roots: Vec<usize> = (0..keys.len()).map(|i| find(&mut parent, i)).collect();
+    let particle_keys: Vec<(i32, i32, i32)> = (0..w.len())
+        .map(|i| {
+            let (kx, ky, kt) = bins.key(xs[i], ys[i], ths[i]);
+            (kx, ky, kt.rem_euclid(theta_bins))
+        })
+        .collect();
+    let (particle_bin, keys, roots) = if fast {
+        let mut dense = DenseBins::new(&particle_keys, theta_bins);
+        let bins = bin_particles(&particle_keys, dense.as_mut());
+        let roots = cluster_roots(&bins.keys, theta_bins, dense.as_ref());
+        (bins.of_particle, bins.keys, roots)
+    } else {
+        let bins = bin_particles(&particle_keys, None);
+        let roots = cluster_roots_plain(&bins.keys, theta_bins);
+        (bins.of_particle, bins.keys, roots)
+    };
     let mut cluster_weight = vec![0.0; keys.len()];
     let mut total = 0.0;
     for (i, &b) in particle_bin.iter().enumerate() {
@@ -137,5 +414,98 @@ mod tests {
         assert!((e.pose.theta.abs() - pi).abs() < 1e-9, "{}", e.pose.theta);
         assert!((e.weight - 0.8).abs() < 1e-9);
         assert!(e.covariance[0][0] > 0.0 && e.covariance[2][2] < 1e-3);
+    }
+
+    /// The dense histogram and the sets joined by size find the same clusters, roots and
+    /// estimate as the plain hash map and smallest-root rule, to the bit: a filter spread over a hospital-sized floor, a tracking cloud, several blobs across
+    /// the heading wrap, and a sparse set too wide for the dense histogram.
+    #[test]
+    fn the_fast_clustering_finds_exactly_the_plain_clusters() {
+        use crate::core::SimRng;
+        use rand::{RngExt, SeedableRng};
+        let mut rng = SimRng::seed_from_u64(7);
+        let pi = std::f64::consts::PI;
+        let mut cases: Vec<Vec<(f64, f64, f64)>> = Vec::new();
+        cases.push(
+            (0..20_000)
+                .map(|_| {
+                    (
+                        rng.random_range(0.0..140.0),
+                        rng.random_range(0.0..60.0),
+                        rng.random_range(-pi..pi),
+                    )
+                })
+                .collect(),
+        );
+        cases.push(
+            (0..3_000)
+                .map(|_| {
+                    (
+                        4.0 + rng.random_range(-0.6..0.6),
+                        -2.0 + rng.random_range(-0.6..0.6),
+                        pi + rng.random_range(-0.3..0.3),
+                    )
+                })
+                .collect(),
+        );
+        cases.push(
+            (0..5_000)
+                .map(|i| {
+                    let c = (i % 5) as f64;
+                    (
+                        c * 3.0 + rng.random_range(-1.0..1.0),
+                        -c * 2.0 + rng.random_range(-1.0..1.0),
+                        rng.random_range(-pi..pi) * (c + 1.0) / 5.0,
+                    )
+                })
+                .collect(),
+        );
+        cases.push(
+            (0..50)
+                .map(|_| {
+                    (
+                        rng.random_range(-5000.0..5000.0),
+                        rng.random_range(-5000.0..5000.0),
+                        rng.random_range(-pi..pi),
+                    )
+                })
+                .collect(),
+        );
+        let bins = BinSize::default();
+        for (n, case) in cases.iter().enumerate() {
+            let xs: Vec<f64> = case.iter().map(|p| p.0).collect();
+            let ys: Vec<f64> = case.iter().map(|p| p.1).collect();
+            let ths: Vec<f64> = case.iter().map(|p| p.2).collect();
+            let w: Vec<f64> = (0..case.len()).map(|_| rng.random::<f64>()).collect();
+            let theta_bins = 36;
+            let keys: Vec<_> = (0..w.len())
+                .map(|i| {
+                    let (kx, ky, kt) = bins.key(xs[i], ys[i], ths[i]);
+                    (kx, ky, kt.rem_euclid(theta_bins))
+                })
+                .collect();
+            let mut grid = DenseBins::new(&keys, theta_bins);
+            assert_eq!(grid.is_some(), n < 3, "case {n}");
+            let dense = bin_particles(&keys, grid.as_mut());
+            let plain = bin_particles(&keys, None);
+            assert_eq!(dense.of_particle, plain.of_particle, "case {n}");
+            assert_eq!(dense.keys, plain.keys, "case {n}");
+            let roots = cluster_roots(&dense.keys, theta_bins, grid.as_ref());
+            assert_eq!(
+                roots,
+                cluster_roots(&plain.keys, theta_bins, None),
+                "case {n}"
+            );
+            assert_eq!(
+                roots,
+                cluster_roots_plain(&plain.keys, theta_bins),
+                "case {n}"
+            );
+            let clusters = roots.iter().enumerate().filter(|&(i, &r)| i == r).count();
+            assert!(clusters >= 1, "case {n}");
+            let a = dominant_cluster_with(&xs, &ys, &ths, &w, &bins, true).unwrap();
+            let b = dominant_cluster_with(&xs, &ys, &ths, &w, &bins, false).unwrap();
+            assert_eq!(format!("{a:?}"), format!("{b:?}"), "case {n}");
+        }
     }
 }
