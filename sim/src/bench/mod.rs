@@ -9,4 +9,5 @@ pub mod matching;
 pub mod profile;
 pub mod record;
 pub mod slam;
+pub mod startup;
 pub mod swarm;

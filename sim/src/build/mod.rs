@@ -7,6 +7,7 @@ pub mod script;
 use crate::build::script::{EventQueue, ScriptPlugin};
 use crate::scenario::{LocalizerKind, PersonConfig, RobotConfig, Scenario};
 use bevy_ecs::prelude::*;
+use std::time::{Duration, Instant};
 use systems::body::{
     Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics, PhysicsPlugin, TruePose, Walker,
 };
@@ -85,6 +86,29 @@ impl Reusable {
     }
 }
 
+/// How long each part of building the world took, in order (`sim bench startup` reports them).
+#[derive(Resource, Default, Clone, Debug)]
+pub struct BuildTimes {
+    pub phases: Vec<(&'static str, Duration)>,
+    last: Option<Instant>,
+}
+
+impl BuildTimes {
+    fn start() -> Self {
+        BuildTimes {
+            phases: Vec::new(),
+            last: Some(Instant::now()),
+        }
+    }
+
+    /// Ends the phase called `name` (it began where the last one ended).
+    fn lap(&mut self, name: &'static str) {
+        let now = Instant::now();
+        let began = self.last.replace(now).unwrap_or(now);
+        self.phases.push((name, now - began));
+    }
+}
+
 /// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
 pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
     build_world_with(scenario, threads, BuildMode::Live, Reusable::default())
@@ -99,13 +123,17 @@ pub fn build_world_with(
     reuse: Reusable,
 ) -> anyhow::Result<SimWorld> {
     let live = mode == BuildMode::Live;
+    let mut times = BuildTimes::start();
     let mut world = World::new();
     let pool = KernelPool::new(threads)
         .map_err(|e| anyhow::anyhow!("cannot start {threads} kernel threads: {e}"))?;
     world.insert_resource(pool);
     world.insert_resource(SimClock::new(scenario.dt));
+    times.lap("kernel pool");
     let mut static_world = StaticWorld::new(scenario.grid.clone());
+    times.lap("ray caster");
     let mut physics = Physics::new(&mut static_world, scenario.dt);
+    times.lap("wall colliders");
     // one shared costmap per distinct inflation setting of the robots with tasks
     let nav_params: Vec<_> = scenario
         .robots
@@ -118,6 +146,7 @@ pub fn build_world_with(
             .costmaps
             .unwrap_or_else(|| NavCostmaps::new(&static_world, &nav_params))
     });
+    times.lap("navigation costmaps");
     world.insert_resource(static_world);
     world.insert_resource(Doors {
         doors: scenario
@@ -143,9 +172,11 @@ pub fn build_world_with(
         );
     }
 
+    times.lap("localization map");
     if live {
         crate::build::outdoor::insert_outdoor_world(&mut world, scenario);
     }
+    times.lap("outdoor world");
     let mut robots = Vec::with_capacity(scenario.robots.len());
     for (i, r) in scenario.robots.iter().enumerate() {
         let body = physics.add_robot(i as u32, &r.start, &r.footprint);
@@ -168,6 +199,7 @@ pub fn build_world_with(
         }
         robots.push(e);
     }
+    times.lap("robots and their localizers");
     let people = scenario
         .people
         .iter()
@@ -177,7 +209,9 @@ pub fn build_world_with(
     if let Some(maps) = costmaps {
         world.insert_resource(maps);
     }
+    times.lap("people");
     physics.prepare();
+    times.lap("first contacts");
     world.insert_resource(physics);
     world.insert_resource(EventQueue::new(
         scenario.events.clone(),
@@ -207,6 +241,8 @@ pub fn build_world_with(
     for p in plugins {
         p.build(&mut world, &mut schedule);
     }
+    times.lap("plugins");
+    world.insert_resource(times);
     Ok(SimWorld {
         world,
         schedule,

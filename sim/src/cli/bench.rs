@@ -17,6 +17,8 @@ pub enum BenchCommand {
     Facade(bench::facade::FacadeBenchOptions),
     /// Where a tick's time goes: each system's time per tick and share, on one thread.
     Profile(bench::profile::ProfileOptions),
+    /// Time before the first tick, phase by phase, and the first tick against the next ones.
+    Startup(bench::startup::StartupOptions),
     /// Real-time factor and time per scan of each SLAM mode on the hospital loop run.
     Slam(bench::slam::SlamBenchOptions),
     /// DE scan-matching time per alignment of 1081-beam hospital scans (one core).
@@ -36,6 +38,7 @@ pub fn bench_command(which: BenchCommand) -> anyhow::Result<()> {
         BenchCommand::Swarm(o) => bench::swarm::run_swarm_bench(&o),
         BenchCommand::Facade(o) => bench::facade::run_facade_bench(&o),
         BenchCommand::Profile(o) => bench::profile::run_profile(&o),
+        BenchCommand::Startup(o) => bench::startup::run_startup_bench(&o),
         BenchCommand::Slam(o) => bench::slam::run_slam_bench(&o).map(drop),
         BenchCommand::DeMatch(o) => bench::matching::run_de_match_bench(&o),
         BenchCommand::Mcl(o) => bench::localization::run_mcl_bench(&o),

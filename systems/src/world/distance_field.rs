@@ -20,6 +20,7 @@
 //! truncated distance depends only on obstacles within `max_dist` of it.
 
 use super::grid::OccupancyGrid;
+use rayon::prelude::*;
 
 /// Byte value meaning "at least `max_dist` from any obstacle" (also used outside the grid).
 pub const FAR: u8 = 255;
@@ -88,11 +89,136 @@ fn transform_1d(f: &[f64], d: &mut [f64], v: &mut [usize], z: &mut [f64]) {
 /// Squared distances (in cells², centre to centre) of a `w` × `h` window to the nearest `true`
 /// cell of `occ`; cells with no `true` cell anywhere read about 1e20. Shared with the navigation
 /// costmap, which inflates obstacles by the same exact transform.
-pub(crate) fn squared_distances(
+///
+/// The columns' pass needs no parabolas for a binary image ([`nearest_along_column`]) and
+/// writes each column contiguously, a blocked transpose turns the result into rows, and the
+/// rows' pass runs in place; both passes spread their lines over rayon's threads. Every finite
+/// value is identical to the bit to [`squared_distances_plain`]'s; where that one reads "no
+/// `true` cell" (about 1e20), so does this one.
+pub fn squared_distances(
     w: usize,
     h: usize,
-    occ: impl Fn(usize, usize) -> bool,
+    occ: impl Fn(usize, usize) -> bool + Sync,
 ) -> Vec<f64> {
+    if w == 0 || h == 0 {
+        return Vec::new();
+    }
+    let scratch =
+        |n: usize| move || -> RowScratch { (vec![0.0; n], vec![0; n], vec![(0, 1); n + 1]) };
+    let mut columns = vec![0.0; w * h];
+    columns
+        .par_chunks_mut(h)
+        .enumerate()
+        .for_each(|(x, column)| nearest_along_column(column, |y| occ(x, y)));
+    let mut g = vec![0.0; w * h];
+    // rows in bands of TRANSPOSE_BLOCK, each band read from the columns block by block
+    g.par_chunks_mut(w * TRANSPOSE_BLOCK)
+        .enumerate()
+        .for_each(|(band, rows)| {
+            let y0 = band * TRANSPOSE_BLOCK;
+            let band_h = rows.len() / w;
+            for x0 in (0..w).step_by(TRANSPOSE_BLOCK) {
+                for x in x0..(x0 + TRANSPOSE_BLOCK).min(w) {
+                    let column = &columns[x * h + y0..x * h + y0 + band_h];
+                    for (dy, &value) in column.iter().enumerate() {
+                        rows[dy * w + x] = value;
+                    }
+                }
+            }
+        });
+    drop(columns);
+    g.par_chunks_mut(w)
+        .for_each_init(scratch(w), |(f, v, z), row| {
+            f.copy_from_slice(row);
+            envelope_of_whole_numbers(f, row, v, z);
+        });
+    g
+}
+
+/// Scratch of the rows' pass: the input row, the envelope's parabolas and their boundaries
+/// (numerator, denominator).
+type RowScratch = (Vec<f64>, Vec<usize>, Vec<(i64, i64)>);
+
+/// [`transform_1d`] for inputs that are squares of whole numbers (or ∞): the parabolas'
+/// intersections are kept as exact fractions and compared by cross-multiplying, with no
+/// division. Parabolas of ∞ are left out; they never win against a finite one, and a row of
+/// nothing but ∞ reads ∞. Two different fractions with denominators below 2·width are at least
+/// 1/(2·width)² apart, more than a double's rounding of the intersections of rows up to about
+/// 4 000 cells long, so there the envelope, and every output, is the one the floating-point
+/// version finds; on longer rows this one is exact where that one may round.
+fn envelope_of_whole_numbers(f: &[f64], d: &mut [f64], v: &mut [usize], z: &mut [(i64, i64)]) {
+    let key = |p: usize| f[p] as i64 + (p * p) as i64;
+    let mut k = usize::MAX; // the envelope's last parabola; MAX while it is empty
+    for (q, &fq) in f.iter().enumerate() {
+        if fq >= INF * 0.5 {
+            continue;
+        }
+        if k == usize::MAX {
+            k = 0;
+            v[0] = q;
+            continue;
+        }
+        let kq = key(q);
+        loop {
+            let p = v[k];
+            let (num, den) = (kq - key(p), 2 * (q - p) as i64);
+            // s <= z[k] for s = num / den, z[k] = zn / zd (both denominators positive)
+            if k > 0 && num * z[k].1 <= z[k].0 * den {
+                k -= 1;
+                continue;
+            }
+            k += 1;
+            v[k] = q;
+            z[k] = (num, den);
+            break;
+        }
+    }
+    if k == usize::MAX {
+        d.fill(INF);
+        return;
+    }
+    let last = k;
+    k = 0;
+    for (q, dq) in d.iter_mut().enumerate() {
+        // the next boundary z[k + 1] < q
+        while k < last && z[k + 1].0 < q as i64 * z[k + 1].1 {
+            k += 1;
+        }
+        let p = v[k];
+        let dp = q.abs_diff(p) as f64;
+        *dq = dp * dp + f[p];
+    }
+}
+
+/// The columns' pass of a binary image: the squared distance to the nearest `true` cell along
+/// the column, from one sweep down and one up. With every input 0 or ∞, this is what the lower
+/// envelope of parabolas computes (the same squares of whole numbers, exactly); a column with
+/// no `true` cell reads ∞ (the envelope's reads ∞ plus rounding), which stays beyond every
+/// finite distance in the rows' pass.
+fn nearest_along_column(column: &mut [f64], occ: impl Fn(usize) -> bool) {
+    let mut last: Option<usize> = None;
+    for (y, d) in column.iter_mut().enumerate() {
+        if occ(y) {
+            last = Some(y);
+        }
+        *d = last.map_or(INF, |p| ((y - p) * (y - p)) as f64);
+    }
+    let mut next: Option<usize> = None;
+    for (y, d) in column.iter_mut().enumerate().rev() {
+        if *d == 0.0 {
+            next = Some(y);
+        } else if let Some(n) = next {
+            *d = d.min(((n - y) * (n - y)) as f64);
+        }
+    }
+}
+
+/// Side of the square blocks [`squared_distances`] transposes in (64 × 64 values, 32 KB).
+const TRANSPOSE_BLOCK: usize = 64;
+
+/// [`squared_distances`] as first written: one line at a time on one thread, the columns' pass
+/// writing straight into the row-major result. The plain version the tests compare with.
+pub fn squared_distances_plain(w: usize, h: usize, occ: impl Fn(usize, usize) -> bool) -> Vec<f64> {
     let mut g = vec![0.0; w * h];
     let n = w.max(h);
     let (mut f, mut d) = (vec![0.0; n], vec![0.0; n]);
@@ -298,5 +424,49 @@ mod tests {
         // and a solid grid is far inside (no boundary anywhere)
         let g = OccupancyGrid::new(5, 4, 0.05, [0.0, 0.0], Cell::Occupied);
         assert!(DistanceField::new(&g, 2.0).cells.iter().all(|&q| q == FAR));
+    }
+
+    /// The parallel, transposing transform equals the plain one to the bit, on the hospital
+    /// floor and on shapes whose sides are not multiples of the transpose block.
+    #[test]
+    fn the_fast_transform_equals_the_plain_one() {
+        let hospital = crate::world::map_file::load_map(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../assets/maps/hospital/hospital.yaml"
+        )))
+        .unwrap();
+        let occ = |x: usize, y: usize| hospital.is_obstacle(x, y);
+        let (w, h) = (hospital.width, hospital.height);
+        // finite values to the bit; "nothing there" (about 1e20) where the plain one says so
+        let same = |fast: &[f64], plain: &[f64]| {
+            fast.len() == plain.len()
+                && fast.iter().zip(plain).all(|(&a, &b)| {
+                    a.to_bits() == b.to_bits() || (a >= INF * 0.5 && b >= INF * 0.5)
+                })
+        };
+        let fast = squared_distances(w, h, occ);
+        let plain = squared_distances_plain(w, h, occ);
+        assert!(same(&fast, &plain));
+        assert!(plain.iter().any(|&d| d > 100.0) && plain.contains(&0.0));
+        for (w, h) in [(1, 1), (1, 70), (70, 1), (65, 129), (130, 63)] {
+            // sparse points, then only a few columns with any (the others read 1e20 after the
+            // columns' pass), then nothing at all
+            let points = |x: usize, y: usize| (x * 7 + y * 13).is_multiple_of(29);
+            let few_columns = |x: usize, y: usize| x % 17 == 3 && y % 5 == 1;
+            let nothing = |_: usize, _: usize| false;
+            assert!(same(
+                &squared_distances(w, h, points),
+                &squared_distances_plain(w, h, points)
+            ));
+            assert!(same(
+                &squared_distances(w, h, few_columns),
+                &squared_distances_plain(w, h, few_columns)
+            ));
+            assert!(same(
+                &squared_distances(w, h, nothing),
+                &squared_distances_plain(w, h, nothing)
+            ));
+        }
+        assert!(squared_distances(0, 5, |_, _| true).is_empty());
     }
 }
