@@ -31,6 +31,7 @@ use crate::core::{Pose2, SimRng, wrap_angle};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// Which laser model weighs the particles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -141,7 +142,10 @@ pub struct Mcl {
     pub updates: u64,
     /// Resamplings done.
     pub resamplings: u64,
-    pub estimate: Option<PoseEstimate>,
+    /// The dominant cluster's estimate, computed when first asked for: a global filter's
+    /// first cloud covers the whole floor (100 000 particles take tens of milliseconds), and
+    /// its first update usually comes before anyone asks.
+    estimate: OnceLock<Option<PoseEstimate>>,
 }
 
 impl Mcl {
@@ -168,7 +172,7 @@ impl Mcl {
             ys.push(y);
             ths.push(th);
         }
-        let mut mcl = Mcl {
+        let mcl = Mcl {
             config,
             xs,
             ys,
@@ -182,9 +186,8 @@ impl Mcl {
             table: None,
             updates: 0,
             resamplings: 0,
-            estimate: None,
+            estimate: OnceLock::new(),
         };
-        mcl.estimate = mcl.cluster();
         mcl
     }
 
@@ -200,8 +203,19 @@ impl Mcl {
         cluster::dominant_cluster(&self.xs, &self.ys, &self.ths, &self.w, &self.config.bins)
     }
 
+    /// Computes the estimate of the particles as they are now, if nobody has asked for it
+    /// since the last correction: they are about to change, and the estimate stands for the
+    /// set as it was built or last corrected.
+    fn settle_estimate(&mut self) {
+        if self.estimate.get().is_none() {
+            let e = self.cluster();
+            self.estimate = OnceLock::from(e);
+        }
+    }
+
     /// Moves every particle by the odometry motion `from` → `to`.
     pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
+        self.settle_estimate();
         let d = self.config.motion.delta(from, to);
         let model = self.config.motion;
         let seeds: Vec<u64> = (0..self.len().div_ceil(MOTION_CHUNK))
@@ -227,6 +241,12 @@ impl Mcl {
 
     /// Multiplies the weights by the scan's likelihood; returns the mean likelihood factor.
     pub fn weigh(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> f64 {
+        self.settle_estimate();
+        self.weigh_particles(map, beams)
+    }
+
+    /// [`Mcl::weigh`] in a correction, which replaces the estimate afterwards.
+    fn weigh_particles(&mut self, map: &LocalizationMap, beams: &BeamSubset) -> f64 {
         let old_total: f64 = self.w.iter().sum();
         match self.config.model {
             LaserModel::LikelihoodField => {
@@ -419,7 +439,7 @@ impl MapLocalizer for Mcl {
         if beams.is_empty() {
             return true;
         }
-        let mean_p = self.weigh(map, beams);
+        let mean_p = self.weigh_particles(map, beams);
         // Augmented MCL: the likelihood is normalised per beam count so α's mean the same for
         // every laser
         let avg = mean_p.max(f64::MIN_POSITIVE);
@@ -458,12 +478,12 @@ impl MapLocalizer for Mcl {
             self.resample(map, p_inject, pool.as_ref());
         }
         self.updates += 1;
-        self.estimate = self.cluster();
+        self.estimate = OnceLock::from(self.cluster());
         true
     }
 
     fn estimate(&self) -> Option<PoseEstimate> {
-        self.estimate
+        *self.estimate.get_or_init(|| self.cluster())
     }
 
     fn box_clone(&self) -> Box<dyn MapLocalizer> {

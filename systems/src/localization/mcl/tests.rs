@@ -37,7 +37,7 @@ fn tracks_from_a_gaussian_around_the_start() {
     drive(&map, &CORRIDOR, start.theta, 1, |truth, odom, scan| {
         let beams = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60);
         if mcl.update(&map, &beams, odom) {
-            errors.push(error(&mcl.estimate.unwrap(), truth));
+            errors.push(error(&MapLocalizer::estimate(&mcl).unwrap(), truth));
         }
     });
     assert!(errors.len() > 100, "{}", errors.len());
@@ -66,7 +66,7 @@ fn converges_from_global_initialisation() {
         let beams = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60);
         if mcl.update(&map, &beams, odom) {
             k += 1;
-            let (d, a) = error(&mcl.estimate.unwrap(), truth);
+            let (d, a) = error(&MapLocalizer::estimate(&mcl).unwrap(), truth);
             if d < 0.2 && a < 5f64.to_radians() {
                 tracked_since.get_or_insert(k);
             } else {
@@ -102,7 +102,7 @@ fn challenges_pull_a_filter_out_of_a_wrong_place() {
         drive(&map, &CORRIDOR, 0.0, 3, |truth, odom, scan| {
             let beams = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60);
             if mcl.update(&map, &beams, odom) {
-                last = error(&mcl.estimate.unwrap(), truth);
+                last = error(&MapLocalizer::estimate(&mcl).unwrap(), truth);
             }
         });
         last
@@ -187,4 +187,38 @@ fn beam_model_prefers_the_true_pose() {
         sensor_model::weigh_beam_model(&map.rays, &params, &beams, &xs, &ys, &ths, &mut w);
         assert!(w[1..].iter().all(|&o| o < w[0]), "{truth:?}: {w:?}");
     }
+}
+
+/// The estimate is computed when first asked for, yet always stands for the set as it was built
+/// or last corrected: the same as computing it at once, before or after particles move.
+#[test]
+fn the_first_estimate_is_the_built_cloud_s_whenever_it_is_asked_for() {
+    let map = hospital();
+    let config = MclConfig {
+        max_particles: 20_000,
+        init: InitialBelief::Global,
+        ..tuned()
+    };
+    let built = Mcl::new(config.clone(), &map, stream_rng(3, "test", "mcl"));
+    let at_once =
+        cluster::dominant_cluster(&built.xs, &built.ys, &built.ths, &built.w, &config.bins);
+    assert!(at_once.is_some());
+    assert_eq!(built.estimate(), at_once);
+    // asked for only after the particles moved: still the built cloud's
+    let mut moved = Mcl::new(config.clone(), &map, stream_rng(3, "test", "mcl"));
+    moved.apply_motion(&Pose2::new(0.0, 0.0, 0.0), &Pose2::new(3.0, 1.0, 0.5));
+    assert_eq!(moved.estimate(), at_once);
+    let now = cluster::dominant_cluster(&moved.xs, &moved.ys, &moved.ths, &moved.w, &config.bins);
+    assert_ne!(now, at_once);
+    // a correction replaces it
+    let scan = scan_at(
+        &map,
+        &Pose2::new(2.2, 16.0, 0.0),
+        &mut stream_rng(3, "test", "scan"),
+    );
+    let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60);
+    assert!(MapLocalizer::correct(&mut moved, &map, &beams));
+    let corrected =
+        cluster::dominant_cluster(&moved.xs, &moved.ys, &moved.ths, &moved.w, &config.bins);
+    assert_eq!(moved.estimate(), corrected);
 }
