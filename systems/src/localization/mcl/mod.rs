@@ -172,7 +172,7 @@ impl Mcl {
             ys.push(y);
             ths.push(th);
         }
-        let mcl = Mcl {
+        Mcl {
             config,
             xs,
             ys,
@@ -187,8 +187,7 @@ impl Mcl {
             updates: 0,
             resamplings: 0,
             estimate: OnceLock::new(),
-        };
-        mcl
+        }
     }
 
     pub fn len(&self) -> usize {
