@@ -147,6 +147,11 @@ pub fn build_world_with(
             .unwrap_or_else(|| NavCostmaps::new(&static_world, &nav_params))
     });
     times.lap("navigation costmaps");
+    // the map the localizers believe in is the floor plan as it is at the start: the static
+    // world's ray caster, not yet edited, serves both
+    let any_localizer = scenario.robots.iter().any(|r| !r.localizers.is_empty());
+    let localizer_rays =
+        (any_localizer && reuse.localization_map.is_none()).then(|| static_world.rays().clone());
     world.insert_resource(static_world);
     world.insert_resource(Doors {
         doors: scenario
@@ -155,8 +160,6 @@ pub fn build_world_with(
             .map(|d| Door::new(d.name.clone(), d.from, d.to, d.thickness))
             .collect(),
     });
-    // the map localizers believe in: the floor plan as it is at the start
-    let any_localizer = scenario.robots.iter().any(|r| !r.localizers.is_empty());
     let field_max_dist = scenario
         .robots
         .iter()
@@ -165,11 +168,12 @@ pub fn build_world_with(
     if any_localizer {
         // DE localizers ray-cast only; the field is then small and unused
         let max_dist = field_max_dist.unwrap_or(scenario.grid.resolution);
-        world.insert_resource(
-            reuse
-                .localization_map
-                .unwrap_or_else(|| LocalizationMap::new(scenario.grid.clone(), max_dist)),
-        );
+        let map = match (reuse.localization_map, localizer_rays) {
+            (Some(map), _) => map,
+            (None, Some(rays)) => LocalizationMap::with_rays(scenario.grid.clone(), max_dist, rays),
+            (None, None) => LocalizationMap::new(scenario.grid.clone(), max_dist),
+        };
+        world.insert_resource(map);
     }
 
     times.lap("localization map");

@@ -22,8 +22,14 @@ impl LocalizationMap {
     /// The map of `grid`, its distance field truncated at `max_dist` (m): the largest distance
     /// any likelihood model using it needs.
     pub fn new(grid: OccupancyGrid, max_dist: f64) -> Self {
-        let field = DistanceField::new(&grid, max_dist);
         let rays = RayMap::from_grid(&grid);
+        Self::with_rays(grid, max_dist, rays)
+    }
+
+    /// [`LocalizationMap::new`] with the ray-casting map of `grid` already built (the static
+    /// world's, before any edit: the same map, so it need not be built twice).
+    pub fn with_rays(grid: OccupancyGrid, max_dist: f64, rays: RayMap) -> Self {
+        let field = DistanceField::new(&grid, max_dist);
         let free = Self::free_cells(&grid);
         LocalizationMap {
             grid,
@@ -87,5 +93,47 @@ impl LocalizationMap {
         self.field.update(&self.grid, &changed);
         self.rays.set_cells(&ray_edits);
         self.free = Self::free_cells(&self.grid);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::raycast::StaticWorld;
+
+    /// The localizers' map built on the static world's ray caster casts every ray and scan as
+    /// one built on its own.
+    #[test]
+    fn a_map_on_the_static_world_s_rays_casts_as_its_own() {
+        let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
+        let grid = crate::world::map_file::load_map(&path).unwrap();
+        let own = LocalizationMap::new(grid.clone(), 2.0);
+        let ground = StaticWorld::new(grid.clone());
+        let shared = LocalizationMap::with_rays(grid, 2.0, ground.rays().clone());
+        assert_eq!(own.field.cells, shared.field.cells);
+        assert_eq!(own.free_count(), shared.free_count());
+        let mut hits = 0;
+        for k in 0..5_000 {
+            let p = [
+                (k * 37 % 640) as f32 * 0.1 + 0.05,
+                (k * 53 % 320) as f32 * 0.1 + 0.05,
+            ];
+            let angle = k as f32 * 0.7331;
+            let (a, b) = (
+                own.rays.cast(p, angle, 20.0),
+                shared.rays.cast(p, angle, 20.0),
+            );
+            assert_eq!(a.to_bits(), b.to_bits(), "ray {k}");
+            hits += usize::from(a < 20.0);
+        }
+        assert!(hits > 2_500, "{hits}");
+        let (mut a, mut b) = (vec![0.0f32; 1081], vec![0.0f32; 1081]);
+        let start = -135f32.to_radians();
+        let inc = 0.25f32.to_radians();
+        own.rays.cast_scan([20.0, 15.0], start, inc, 20.0, &mut a);
+        shared
+            .rays
+            .cast_scan([20.0, 15.0], start, inc, 20.0, &mut b);
+        assert_eq!(a, b);
     }
 }

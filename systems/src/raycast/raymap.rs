@@ -20,6 +20,7 @@ const TILE: usize = 1 << TILE_SHIFT;
 /// Bytes after the field's last cell, so a 4-byte gather at any cell stays inside it.
 const PAD: usize = 3;
 
+#[derive(Clone)]
 pub struct RayMap {
     w: usize,
     h: usize,

@@ -178,6 +178,7 @@ struct Tile {
     groups: [u32; FACINGS + 1],
 }
 
+#[derive(Clone)]
 pub(crate) struct Faces {
     tw: usize,
     th: usize,
