@@ -90,7 +90,7 @@ fn transform_1d(f: &[f64], d: &mut [f64], v: &mut [usize], z: &mut [f64]) {
 /// cell of `occ`; cells with no `true` cell anywhere read about 1e20. Shared with the navigation
 /// costmap, which inflates obstacles by the same exact transform.
 ///
-/// The columns' pass needs no parabolas for a binary image ([`nearest_along_column`]) and
+/// The columns' pass needs no parabolas for a binary image (two sweeps per column) and
 /// writes each column contiguously, a blocked transpose turns the result into rows, and the
 /// rows' pass runs in place; both passes spread their lines over rayon's threads. Every finite
 /// value is identical to the bit to [`squared_distances_plain`]'s; where that one reads "no
