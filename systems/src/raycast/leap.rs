@@ -18,7 +18,9 @@
 //! hospital, random free poses, 20 m: 5.8 moves per ray against 7.8, and 9.6–10.2 against
 //! 8.3–9.4 M single rays/s; the streams, the other way round, 16.9 against 11.1 M rays/s). It
 //! works in cell units ([`InCells`]), which shortens each move's chain by two multiplications
-//! (about 10 % more single rays/s) at the cost of millimetres at grazing incidence.
+//! (about 10 % more single rays/s) at the cost of millimetres at grazing incidence. `cast` makes
+//! these moves through [`Single`], the same arithmetic arranged without unpredictable branches;
+//! `Lane::exit_square` stays for rays along an axis and as the reference of the tests.
 
 use super::dda::{enter_grid, step_sign};
 
@@ -192,16 +194,16 @@ impl Lane {
     }
 }
 
-/// A ray in cell units for [`Lane::exit_square`]: its origin in cells plus one (so truncation
-/// floors every point above −1 cell), the cells it crosses per metre of travel on each axis, and
-/// the travel per cell. Each move of a single ray is a chain of dependent operations, and these
-/// factors take two multiplications out of it (10 % more single rays per second). The price is
-/// rounding: the origin is rounded in cells rather than each boundary in metres, so a ray meeting
-/// a wall at a grazing angle (a few hundredths of a degree, where a micrometre across the ray
-/// is a millimetre along it) can end a few millimetres from [`super::cast_dda`]'s answer on a
+/// A ray in cell units for [`Lane::exit_square`] and [`Single`]: its origin in cells plus one (so
+/// truncation floors every point above −1 cell), the cells it crosses per metre of travel on each
+/// axis, and the travel per cell. Each move of a single ray is a chain of dependent operations, and
+/// these factors take two multiplications out of it (10 % more single rays per second). The price
+/// is rounding: the origin is rounded in cells rather than each boundary in metres, so a ray
+/// meeting a wall at a grazing angle (a few hundredths of a degree, where a micrometre across the
+/// ray is a millimetre along it) can end a few millimetres from [`super::cast_dda`]'s answer on a
 /// large map; on the hospital doubled (2560 × 640 cells, 2 M random rays) 5 rays differed by more
-/// than 1 mm, at most 4 mm, and the exact answers lay 0.6–3 mm from ours, 0.2–1.1 mm from the
-/// cell walk's.
+/// than 1 mm, at most 4 mm, and the exact answers lay 0.6–3 mm from ours, 0.2–1.1 mm from the cell
+/// walk's.
 pub(super) struct InCells {
     gx1: f32,
     gy1: f32,
@@ -222,6 +224,129 @@ impl InCells {
             idx: l.idx * b.res,
             idy: l.idy * b.res,
         }
+    }
+}
+
+/// A single ray whose direction has no zero component ([`step_sign`] ±1 on both axes), for
+/// [`super::RayMap::cast`]: the moves of [`Lane::exit_square`], to the bit, arranged for a short
+/// chain of dependent operations from one distance value to the next cell's address. Both exits
+/// are computed and the earlier one picked without a branch (which axis comes first is hard to
+/// predict), and `exit_square`'s guards (the `max` with the previous parameter, the clamp into
+/// the square) leave the chain for a predicted branch, since they almost never act.
+pub(super) struct Single {
+    u: InCells,
+    sx: i32,
+    sy: i32,
+    /// The boundary index + 1 of `exit_square` is `c + s·k + o` on each axis.
+    ox: i32,
+    oy: i32,
+}
+
+impl Single {
+    /// The ray from grid-relative (gx, gy) along (dx, dy); None when a component is within 1e-12
+    /// of zero (or not a number).
+    #[inline(always)]
+    pub fn new(gx: f32, gy: f32, dx: f32, dy: f32, b: &Bounds) -> Option<Single> {
+        let (sx, sy) = (step_sign(dx), step_sign(dy));
+        if sx == 0 || sy == 0 {
+            return None;
+        }
+        // what `Lane::new` and `InCells::new` compute for this ray
+        let l = Lane {
+            gx,
+            gy,
+            dx,
+            dy,
+            idx: 1.0 / dx,
+            idy: 1.0 / dy,
+            ..Lane::default()
+        };
+        Some(Single {
+            u: InCells::new(&l, b),
+            sx,
+            sy,
+            ox: (sx > 0) as i32 - sx + 1,
+            oy: (sy > 0) as i32 - sy + 1,
+        })
+    }
+
+    /// One move out of the free square around cell (cx, cy), whose distance value is `k` ≥ 2,
+    /// entered at `t`: [`Lane::exit_square`] without the bounds test.
+    #[inline(always)]
+    pub fn exit_square(&self, k: i32, cx: i32, cy: i32, t: f32) -> (i32, i32, f32) {
+        let u = &self.u;
+        let (kx, ky) = (self.sx * k, self.sy * k);
+        let tx = ((cx + kx + self.ox) as f32 - u.gx1) * u.idx;
+        let ty = ((cy + ky + self.oy) as f32 - u.gy1) * u.idy;
+        // the other index after each exit, as `across` has it before its clamp (the later
+        // exit's can lie far outside)
+        let ay = truncate(u.gy1 + u.dy * tx).wrapping_sub(1);
+        let ax = truncate(u.gx1 + u.dx * ty).wrapping_sub(1);
+        let xfirst = tx < ty;
+        let pick = |a: i32, b: i32| std::hint::select_unpredictable(xfirst, a, b);
+        // how far forward that index went: 0..k inside the square, where `across` keeps it
+        let ahead = pick(
+            ay.wrapping_sub(cy).wrapping_mul(self.sy),
+            ax.wrapping_sub(cx).wrapping_mul(self.sx),
+        );
+        let nt = if xfirst { tx } else { ty };
+        if t > nt || ahead as u32 >= k as u32 {
+            return self.guarded(k, cx, cy, t);
+        }
+        (pick(cx + kx, ax), pick(ay, cy + ky), nt)
+    }
+
+    /// [`Single::exit_square`] when a guard of [`Lane::exit_square`] acts: the boundary lies a
+    /// rounding error behind `t`, or the crossing point a hair outside the square.
+    #[cold]
+    #[inline(never)]
+    fn guarded(&self, k: i32, cx: i32, cy: i32, t: f32) -> (i32, i32, f32) {
+        let u = &self.u;
+        let (kx, ky) = (self.sx * k, self.sy * k);
+        let tx = ((cx + kx + self.ox) as f32 - u.gx1) * u.idx;
+        let ty = ((cy + ky + self.oy) as f32 - u.gy1) * u.idy;
+        if tx < ty {
+            let t = tx.max(t);
+            (cx + kx, across(u.gy1, u.dy, t, cy, ky - self.sy), t)
+        } else {
+            let t = ty.max(t);
+            (across(u.gx1, u.dx, t, cx, kx - self.sx), cy + ky, t)
+        }
+    }
+
+    /// The move from a cell whose value is 1 (next to an obstacle): the cell step of
+    /// [`Lane::exit_square`], whose square is the cell, so no crossing point is needed.
+    #[inline(always)]
+    pub fn step(&self, cx: i32, cy: i32, t: f32) -> (i32, i32, f32) {
+        let u = &self.u;
+        let tx = ((cx + self.sx + self.ox) as f32 - u.gx1) * u.idx;
+        let ty = ((cy + self.sy + self.oy) as f32 - u.gy1) * u.idy;
+        let xfirst = tx < ty;
+        let pick = |a: i32, b: i32| std::hint::select_unpredictable(xfirst, a, b);
+        let nt = if xfirst { tx } else { ty };
+        // `nt.max(t)` (neither is NaN) without its NaN test
+        (
+            pick(cx + self.sx, cx),
+            pick(cy, cy + self.sy),
+            if t > nt { t } else { nt },
+        )
+    }
+}
+
+/// `x as i32` by the bare x86-64 truncation, without Rust's saturation (NaN and out-of-range
+/// values give i32::MIN instead): two instructions fewer in each move. Such values only occur
+/// for the exit not taken, or fail the guard of [`Single::exit_square`], whose path saturates.
+#[inline(always)]
+fn truncate(x: f32) -> i32 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_cvttss_si32, _mm_set_ss};
+        // SAFETY: SSE is part of the x86-64 baseline
+        unsafe { _mm_cvttss_si32(_mm_set_ss(x)) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        x as i32
     }
 }
 

@@ -10,7 +10,7 @@
 //! around a ray share few cache lines; measured, memory latency — not arithmetic — dominates
 //! random rays on a row-major map.
 
-use super::leap::{Bounds, InCells, Lane};
+use super::leap::{Bounds, InCells, Lane, Single};
 use super::sweep::{Faces, TILE as FACE_TILE};
 
 /// Distances are capped, so an edit only changes the field within this many cells.
@@ -28,6 +28,8 @@ pub struct RayMap {
     origin: [f32; 2],
     /// Tiles per row.
     tw: usize,
+    /// The grid for the walks.
+    bounds: Bounds,
     /// The field in tiled order, then [`PAD`] bytes.
     dist: Vec<u8>,
     /// Streams of rays use the AVX2 kernel (detected, and the field fits `i32` indices).
@@ -64,6 +66,7 @@ impl RayMap {
             res: resolution,
             origin,
             tw,
+            bounds: Bounds::new(width, height, resolution),
             dist: vec![CAP; tw * th * TILE * TILE + PAD],
             avx2: crate::core::cpu::has_avx2() && tw * th * TILE * TILE + PAD <= i32::MAX as usize,
             faces: Faces::new(0, 0, resolution, &|_, _| false),
@@ -249,26 +252,85 @@ impl RayMap {
     /// [`RayMap::cast_many`] overlaps their walks and is several times faster per ray.
     #[inline]
     pub fn cast(&self, p: [f32; 2], angle: f32, max_range: f32) -> f32 {
+        let b = self.bounds;
+        let (gx, gy) = (p[0] - self.origin[0], p[1] - self.origin[1]);
+        // from inside the grid the first cell needs no direction (it is `Lane::new`'s at t = 0),
+        // so its load overlaps sin_cos
+        let inside = gx >= 0.0 && gy >= 0.0 && gx < b.wf && gy < b.hf;
+        let cx = ((gx * b.inv_res) as i32).clamp(0, b.w - 1);
+        let cy = ((gy * b.inv_res) as i32).clamp(0, b.h - 1);
         let (dy, dx) = angle.sin_cos();
+        if inside && let Some(ray) = Single::new(gx, gy, dx, dy, &b) {
+            return self.walk(&ray, cx, cy, 0.0, &b, max_range);
+        }
         self.cast_dir(p, dx, dy, max_range)
     }
 
     fn cast_dir(&self, p: [f32; 2], dx: f32, dy: f32, max_range: f32) -> f32 {
-        let b = Bounds::new(self.w, self.h, self.res);
+        let b = self.bounds;
         let (gx, gy) = (p[0] - self.origin[0], p[1] - self.origin[1]);
-        let mut lane = match Lane::start(gx, gy, dx, dy, &b, max_range) {
+        let lane = match Lane::start(gx, gy, dx, dy, &b, max_range) {
             Ok(lane) => lane,
             Err(answer) => return answer,
         };
-        let cells = InCells::new(&lane, &b);
+        match Single::new(gx, gy, dx, dy, &b) {
+            Some(ray) => self.walk(&ray, lane.cx, lane.cy, lane.t, &b, max_range),
+            None => self.walk_plain(lane, &b, max_range),
+        }
+    }
+
+    /// The walk of [`Single`] from cell (cx, cy), entered at `t`.
+    #[inline(always)]
+    fn walk(
+        &self,
+        ray: &Single,
+        mut cx: i32,
+        mut cy: i32,
+        mut t: f32,
+        b: &Bounds,
+        max_range: f32,
+    ) -> f32 {
+        loop {
+            let k = self.dist[self.idx(cx as usize, cy as usize)];
+            if k == 0 {
+                return t;
+            }
+            // a branch on purpose: predicted, the cell step next to a wall starts before the load
+            // is back
+            (cx, cy, t) = if k == 1 {
+                ray.step(cx, cy, t)
+            } else {
+                ray.exit_square(k as i32, cx, cy, t)
+            };
+            if t > max_range || cx as u32 >= b.w as u32 || cy as u32 >= b.h as u32 {
+                return f32::INFINITY;
+            }
+        }
+    }
+
+    /// The plain walk ([`Lane::exit_square`]): rays along an axis, and the reference of the tests.
+    fn walk_plain(&self, mut lane: Lane, b: &Bounds, max_range: f32) -> f32 {
+        let cells = InCells::new(&lane, b);
         loop {
             let k = self.dist[self.idx(lane.cx as usize, lane.cy as usize)];
             if k == 0 {
                 return lane.t;
             }
-            if !lane.exit_square(k, &cells, &b, max_range) {
+            if !lane.exit_square(k, &cells, b, max_range) {
                 return f32::INFINITY;
             }
+        }
+    }
+
+    /// [`RayMap::cast`] by the plain walk alone.
+    #[cfg(test)]
+    pub(super) fn cast_plain(&self, p: [f32; 2], angle: f32, max_range: f32) -> f32 {
+        let (dy, dx) = angle.sin_cos();
+        let b = self.bounds;
+        let (gx, gy) = (p[0] - self.origin[0], p[1] - self.origin[1]);
+        match Lane::start(gx, gy, dx, dy, &b, max_range) {
+            Ok(lane) => self.walk_plain(lane, &b, max_range),
+            Err(answer) => answer,
         }
     }
 
