@@ -37,6 +37,8 @@ pub struct SimWorld {
     pub robots: Vec<Entity>,
     /// Walking people in spawn (index) order.
     pub people: Vec<Entity>,
+    /// What the world was built for: which plugins compose its schedule.
+    mode: BuildMode,
 }
 
 impl SimWorld {
@@ -49,6 +51,41 @@ impl SimWorld {
     pub fn time(&self) -> f64 {
         self.world.resource::<SimClock>().start()
     }
+
+    /// Composes the schedule again from the plugins, after parts were added to or removed from
+    /// the world (a program's estimators or controllers, a replay's odometry): each plugin adds
+    /// only the systems that have something to work on. Systems added to the old schedule are
+    /// dropped, so this comes before any such addition.
+    pub fn compose_schedule(&mut self) {
+        self.schedule = compose_schedule(&mut self.world, self.mode);
+    }
+}
+
+/// The tick schedule for `world`, from the plugins of `mode`.
+fn compose_schedule(world: &mut World, mode: BuildMode) -> Schedule {
+    let mut schedule = new_schedule();
+    let plugins: &[&dyn SimPlugin] = match mode {
+        BuildMode::Live => &[
+            &ScriptPlugin,
+            &NavigationPlugin,
+            &PeoplePlugin,
+            &PhysicsPlugin,
+            &SensorsPlugin,
+            &LocalizationPlugin,
+            &MappingPlugin,
+            &EvalPlugin,
+        ],
+        BuildMode::Replay => &[
+            &ScriptPlugin,
+            &LocalizationPlugin,
+            &MappingPlugin,
+            &EvalPlugin,
+        ],
+    };
+    for p in plugins {
+        p.build(world, &mut schedule);
+    }
+    schedule
 }
 
 /// What the world is built for.
@@ -223,28 +260,7 @@ pub fn build_world_with(
         &robots,
     ));
 
-    let mut schedule = new_schedule();
-    let plugins: &[&dyn SimPlugin] = match mode {
-        BuildMode::Live => &[
-            &ScriptPlugin,
-            &NavigationPlugin,
-            &PeoplePlugin,
-            &PhysicsPlugin,
-            &SensorsPlugin,
-            &LocalizationPlugin,
-            &MappingPlugin,
-            &EvalPlugin,
-        ],
-        BuildMode::Replay => &[
-            &ScriptPlugin,
-            &LocalizationPlugin,
-            &MappingPlugin,
-            &EvalPlugin,
-        ],
-    };
-    for p in plugins {
-        p.build(&mut world, &mut schedule);
-    }
+    let schedule = compose_schedule(&mut world, mode);
     times.lap("plugins");
     world.insert_resource(times);
     Ok(SimWorld {
@@ -252,6 +268,7 @@ pub fn build_world_with(
         schedule,
         robots,
         people,
+        mode,
     })
 }
 

@@ -82,6 +82,7 @@ pub fn build_replay(plan: ReplayPlan, threads: usize) -> anyhow::Result<(SimWorl
         }
         robots.push(FedRobot::new(entity, feed));
     }
+    sim.compose_schedule();
     ReplayFeedPlugin::new(ReplayFeed { robots }).build(&mut sim.world, &mut sim.schedule);
     Ok((sim, scenario))
 }

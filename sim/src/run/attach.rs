@@ -12,8 +12,10 @@ use systems::core::SimSet;
 use systems::eval::{LocalizationSamples, NavOutcome};
 use systems::localization::{Filter, LocalizationMap, Localizer, Localizers, WheelOdometry};
 use systems::navigation::behaviour::drive_behaviours;
+use systems::navigation::drive::drive_navigators;
 use systems::navigation::held::apply_held_commands;
 use systems::navigation::road_drive::RoadNavigator;
+use systems::navigation::road_drive::system::drive_road_navigators;
 use systems::navigation::{Behaviour, Navigator};
 use systems::sensors::Laser;
 
@@ -84,6 +86,9 @@ pub(super) fn attach_estimators(
             .items
             .push(Localizer::new(name, filter));
     }
+    // run_localizers, run_slam and the evaluation of localizers join the schedule if the
+    // scenario had no localizer
+    sim.compose_schedule();
     Ok(())
 }
 
@@ -122,9 +127,13 @@ pub(super) fn attach_controllers(
         items,
         failure: None,
     });
+    // the drivers of the robots the program took over may have nothing left to drive
+    sim.compose_schedule();
     sim.schedule.add_systems(
         run_user_controllers
             .in_set(SimSet::Control)
+            .after(drive_navigators)
+            .after(drive_road_navigators)
             .after(drive_behaviours)
             .after(walk_people)
             .before(apply_held_commands),

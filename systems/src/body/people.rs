@@ -337,8 +337,10 @@ pub fn walk_people(
 pub struct PeoplePlugin;
 
 impl SimPlugin for PeoplePlugin {
-    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
-        schedule.add_systems(walk_people.in_set(SimSet::Control));
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        if crate::core::any_with::<Walker>(world) {
+            schedule.add_systems(walk_people.in_set(SimSet::Control));
+        }
     }
 }
 

@@ -15,7 +15,9 @@ use super::footprint::Footprint;
 use super::kinematics::{DriveCommand, DriveState, Kinematics, integrate_arc};
 use super::people::Walker;
 use super::truth::{TruePose, TrueTwist};
-use crate::core::{KernelPool, Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle};
+use crate::core::{
+    JobMemory, KernelPool, Pose2, RobotIndex, SimClock, SimPlugin, SimSet, wrap_angle,
+};
 use crate::raycast::static_world::{COLLIDER_TILE, StaticWorld};
 use crate::world::rects::tile_rects;
 use bevy_ecs::prelude::*;
@@ -309,6 +311,7 @@ pub fn physics_step(
     mut world: ResMut<StaticWorld>,
     clock: Res<SimClock>,
     pool: Res<KernelPool>,
+    mut memory: Local<JobMemory>,
     mut robots: Query<(
         &PhysicsBody,
         &Kinematics,
@@ -324,10 +327,14 @@ pub fn physics_step(
         physics.rebuild_tile(&world, tx, ty);
     }
     let dt = clock.dt;
-    let mut jobs: Vec<_> = robots
-        .iter_mut()
-        .map(|(body, kin, cmd, state, truth, twist)| (*body, kin, cmd, state, truth, twist, None))
-        .collect();
+    let mut jobs = memory.take();
+    jobs.extend(
+        robots
+            .iter_mut()
+            .map(|(body, kin, cmd, state, truth, twist)| {
+                (*body, kin, cmd, state, truth, twist, None)
+            }),
+    );
     {
         let bodies = &physics.world.bodies;
         pool.for_each(&mut jobs, |(body, kin, cmd, state, truth, _, vel)| {
@@ -385,6 +392,7 @@ pub fn physics_step(
             truth.pose = pose;
         }
     });
+    memory.keep(jobs);
 }
 
 pub struct PhysicsPlugin;

@@ -5,6 +5,7 @@
 pub mod clock;
 pub mod cpu;
 pub mod ids;
+pub mod jobs;
 pub mod moments;
 pub mod normal;
 pub mod pool;
@@ -17,7 +18,10 @@ pub mod test_tools;
 
 pub use clock::SimClock;
 pub use ids::{RobotId, RobotIndex};
+pub use jobs::JobMemory;
 pub use pool::KernelPool;
 pub use pose::{Pose2, wrap_angle};
 pub use rng::{SimRng, stream_rng, stream_seed};
-pub use schedule::{SimPlugin, SimSet, TickSystem, deny_ambiguities, new_schedule, tick_order};
+pub use schedule::{
+    Chained, SimPlugin, SimSet, TickSystem, any_with, deny_ambiguities, new_schedule, tick_order,
+};

@@ -127,6 +127,37 @@ impl KernelPool {
         }
     }
 
+    /// [`KernelPool::for_each_init`] with scratch the caller keeps from call to call (a system's
+    /// `Local`), so that a tick allocates none: the items are cut into at most four runs per
+    /// worker, each run with its own scratch (made by `S::default()` the first time).
+    pub fn for_each_with<T: Send, S: Default + Send>(
+        &self,
+        items: &mut [T],
+        scratch: &mut Vec<S>,
+        f: impl Fn(&mut S, &mut T) + Send + Sync,
+    ) {
+        use rayon::prelude::*;
+        let runs = if self.threads() < 2 {
+            1
+        } else {
+            items.len().min(4 * self.threads()).max(1)
+        };
+        if scratch.len() < runs {
+            scratch.resize_with(runs, S::default);
+        }
+        if runs == 1 {
+            items.iter_mut().for_each(|item| f(&mut scratch[0], item));
+        } else {
+            let run = items.len().div_ceil(runs);
+            self.install(|| {
+                items
+                    .par_chunks_mut(run)
+                    .zip(scratch.par_iter_mut())
+                    .for_each(|(run, s)| run.iter_mut().for_each(|item| f(s, item)))
+            });
+        }
+    }
+
     /// [`KernelPool::for_each_init`] without scratch.
     pub fn for_each<T: Send>(&self, items: &mut [T], f: impl Fn(&mut T) + Send + Sync) {
         self.for_each_init(items, || (), |_, item| f(item));
@@ -143,6 +174,31 @@ mod tests {
             let e = KernelPool::new(n).err().expect("too many threads accepted");
             assert!(matches!(e, PoolError::TooMany(t) if t == n), "{e}");
             assert!(e.to_string().contains("1024"), "{e}");
+        }
+    }
+
+    /// Every item once, whatever the count and the threads; the scratch is made once per run
+    /// and kept for the next call.
+    #[test]
+    fn for_each_with_visits_every_item_once_and_keeps_its_scratch() {
+        for threads in [1, 2, 3] {
+            let pool = KernelPool::new(threads).unwrap();
+            let mut scratch: Vec<Vec<usize>> = Vec::new();
+            for n in [0, 1, 2, 7, 100] {
+                let mut items: Vec<usize> = (0..n).collect();
+                pool.for_each_with(&mut items, &mut scratch, |s, x| {
+                    s.push(*x);
+                    *x *= 2;
+                });
+                assert_eq!(items, (0..n).map(|x| x * 2).collect::<Vec<_>>());
+                assert!(scratch.len() <= 4 * threads);
+            }
+            // each item went through exactly one run's scratch, in all calls together
+            let mut seen: Vec<usize> = scratch.concat();
+            seen.sort_unstable();
+            let mut expected: Vec<usize> = [0, 1, 2, 7, 100].iter().flat_map(|&n| 0..n).collect();
+            expected.sort_unstable();
+            assert_eq!(seen, expected);
         }
     }
 

@@ -9,8 +9,10 @@
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{
-    LogLevel, ScheduleBuildSettings, ScheduleLabel, SingleThreadedExecutor, SystemSet,
+    Chain, IntoScheduleConfigs, LogLevel, ScheduleBuildSettings, ScheduleConfigs, ScheduleLabel,
+    SingleThreadedExecutor, SystemSet,
 };
+use bevy_ecs::system::ScheduleSystem;
 use std::collections::HashMap;
 
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -113,6 +115,54 @@ pub fn tick_order(schedule: &mut Schedule, world: &mut World) -> Result<Vec<Tick
 }
 
 /// Each feature folder exposes one plugin that adds its systems (and resources) to the schedule.
+/// A plugin builds after the world is populated and adds only the systems that have something to
+/// work on in it ([`any_with`], [`Chained`]): a system with nothing to do still costs the executor
+/// and its parameters' fetching every tick, which in a one-robot world is most of the tick.
 pub trait SimPlugin {
     fn build(&self, world: &mut World, schedule: &mut Schedule);
+}
+
+/// Whether some entity of `world` has component `C`.
+pub fn any_with<C: Component>(world: &mut World) -> bool {
+    world
+        .query_filtered::<(), With<C>>()
+        .iter(world)
+        .next()
+        .is_some()
+}
+
+/// Systems of one set that run in the order they are added, like `.chain()`, where each may be
+/// left out: a plugin adds a system only when what it works on is present.
+#[derive(Default)]
+pub struct Chained(Vec<ScheduleConfigs<ScheduleSystem>>);
+
+impl Chained {
+    pub fn new() -> Self {
+        Chained::default()
+    }
+
+    /// Appends `system` when `present`.
+    pub fn add<M>(
+        mut self,
+        present: bool,
+        system: impl IntoScheduleConfigs<ScheduleSystem, M>,
+    ) -> Self {
+        if present {
+            self.0.push(system.into_configs());
+        }
+        self
+    }
+
+    /// Adds the systems kept, in order, to `set` of `schedule`.
+    pub fn add_to(self, schedule: &mut Schedule, set: SimSet) {
+        if self.0.is_empty() {
+            return;
+        }
+        let group = ScheduleConfigs::Configs {
+            configs: self.0,
+            collective_conditions: Vec::new(),
+            metadata: Chain::Unchained,
+        };
+        schedule.add_systems(group.chain().in_set(set));
+    }
 }

@@ -42,6 +42,9 @@ pub struct SpatialOrder {
     rank: Vec<u32>,
     /// Calls since the last sort.
     age: u32,
+    /// Scratch of the sort and of the moves, kept so that a call allocates nothing.
+    keyed: Vec<(u64, u32)>,
+    place: Vec<u32>,
 }
 
 impl SpatialOrder {
@@ -62,25 +65,25 @@ impl SpatialOrder {
                 .zip(&self.entities)
                 .all(|(t, &e)| entity(t) == e);
         if !same || self.age >= Self::REFRESH_CALLS {
-            let mut keyed: Vec<(u64, u32)> = items
-                .iter()
-                .enumerate()
-                .map(|(i, t)| {
-                    let (x, y) = position(t);
-                    (morton_key(x, y), i as u32)
-                })
-                .collect();
-            keyed.sort_unstable();
+            self.keyed.clear();
+            self.keyed.extend(items.iter().enumerate().map(|(i, t)| {
+                let (x, y) = position(t);
+                (morton_key(x, y), i as u32)
+            }));
+            self.keyed.sort_unstable();
             self.rank.resize(n, 0);
-            for (r, &(_, i)) in keyed.iter().enumerate() {
+            for (r, &(_, i)) in self.keyed.iter().enumerate() {
                 self.rank[i as usize] = r as u32;
             }
-            self.entities = items.iter().map(&entity).collect();
+            self.entities.clear();
+            self.entities.extend(items.iter().map(&entity));
             self.age = 0;
         }
         self.age += 1;
         // in place: the item at i goes to place[i], and whatever was there comes to i
-        let (mut items, mut place) = (items, self.rank.clone());
+        let (mut items, place) = (items, &mut self.place);
+        place.clear();
+        place.extend_from_slice(&self.rank);
         for i in 0..n {
             while place[i] as usize != i {
                 let j = place[i] as usize;

@@ -14,24 +14,32 @@ pub use navigation_metrics::NavOutcome;
 pub use robot_metrics::RobotMetrics;
 pub use trajectory::Sample;
 
-use crate::core::{SimPlugin, SimSet};
+use crate::core::{Chained, SimPlugin, SimSet, any_with};
 use bevy_ecs::prelude::*;
 
 pub struct EvalPlugin;
 
 impl SimPlugin for EvalPlugin {
-    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
         // evaluate_navigation reads the metrics accumulate_metrics writes; the other two share
         // nothing with them, and are chained too so that the order is the same in every run
-        schedule.add_systems(
-            (
+        Chained::new()
+            .add(
+                any_with::<RobotMetrics>(world),
                 robot_metrics::accumulate_metrics,
+            )
+            .add(
+                any_with::<NavOutcome>(world),
                 navigation_metrics::evaluate_navigation,
+            )
+            .add(
+                any_with::<LocalizationSamples>(world),
                 localization_metrics::sample_localization,
+            )
+            .add(
+                any_with::<road_metrics::RoadRunMetrics>(world),
                 road_metrics::evaluate_road_runs,
             )
-                .chain()
-                .in_set(SimSet::Evaluate),
-        );
+            .add_to(schedule, SimSet::Evaluate);
     }
 }

@@ -35,23 +35,25 @@ pub use odometry::{NavBelief, OdometryModel, WheelOdometry};
 pub use road::{RoadGrid, RoadLocalizer, RoadMcl, RoadObservation, RoadPosition};
 pub use scan_estimator::{GraphEdgeKind, GraphEdgeView, GraphView, ScanEstimator};
 
-use crate::core::{SimPlugin, SimSet};
+use crate::core::{Chained, SimPlugin, SimSet, any_with};
 use bevy_ecs::prelude::*;
 
 pub struct LocalizationPlugin;
 
 impl SimPlugin for LocalizationPlugin {
-    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
-        schedule.add_systems(
-            (
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        Chained::new()
+            .add(
+                any_with::<WheelOdometry>(world),
                 odometry::integrate_odometry,
-                road_wiring::run_road_localizers,
-                localizer::run_localizers,
-                nav_source::fuse_nav_belief,
             )
-                .chain()
-                .in_set(SimSet::Estimate),
-        );
+            .add(
+                any_with::<road_wiring::RoadLocalization>(world),
+                road_wiring::run_road_localizers,
+            )
+            .add(any_with::<Localizers>(world), localizer::run_localizers)
+            .add(any_with::<NavSource>(world), nav_source::fuse_nav_belief)
+            .add_to(schedule, SimSet::Estimate);
     }
 }
 

@@ -55,8 +55,10 @@ use bevy_ecs::prelude::*;
 pub struct MappingPlugin;
 
 impl SimPlugin for MappingPlugin {
-    fn build(&self, _world: &mut World, schedule: &mut Schedule) {
-        schedule.add_systems(run_slam.in_set(SimSet::Map));
+    fn build(&self, world: &mut World, schedule: &mut Schedule) {
+        if crate::core::any_with::<Localizers>(world) {
+            schedule.add_systems(run_slam.in_set(SimSet::Map));
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 
 use super::avoid::SectorRanges;
 use crate::body::{DriveCommand, Kinematics};
-use crate::core::{KernelPool, Pose2, SimClock, SimRng, wrap_angle};
+use crate::core::{JobMemory, KernelPool, Pose2, SimClock, SimRng, wrap_angle};
 use crate::localization::NavBelief;
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
@@ -167,6 +167,7 @@ impl Behaviour {
 pub fn drive_behaviours(
     clock: Res<SimClock>,
     pool: Res<KernelPool>,
+    mut memory: Local<JobMemory>,
     mut robots: Query<(
         &mut Behaviour,
         &NavBelief,
@@ -176,7 +177,8 @@ pub fn drive_behaviours(
     )>,
 ) {
     let now = clock.start();
-    let mut jobs: Vec<_> = robots.iter_mut().collect();
+    let mut jobs = memory.take();
+    jobs.extend(robots.iter_mut());
     pool.for_each(&mut jobs, |(b, belief, kin, cmd, laser)| {
         if let Some((laser, scans)) = laser {
             if let Some(scan) = scans.scans.last() {
@@ -189,4 +191,5 @@ pub fn drive_behaviours(
         }
         **cmd = b.command(&belief.pose, now, kin);
     });
+    memory.keep(jobs);
 }

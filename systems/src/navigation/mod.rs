@@ -48,7 +48,7 @@ pub use road_recognition::{
 pub use shared_costmaps::NavCostmaps;
 pub use tasks::{Goal, Step, Task, TaskKind};
 
-use crate::core::{SimPlugin, SimSet};
+use crate::core::{Chained, SimPlugin, SimSet, any_with};
 use bevy_ecs::prelude::*;
 
 pub struct NavigationPlugin;
@@ -56,29 +56,28 @@ pub struct NavigationPlugin;
 impl SimPlugin for NavigationPlugin {
     fn build(&self, world: &mut World, schedule: &mut Schedule) {
         world.init_resource::<Fleet>();
-        schedule.add_systems(
-            (
+        let navigators = any_with::<Navigator>(world);
+        let road_navigators = any_with::<road_drive::RoadNavigator>(world);
+        Chained::new()
+            .add(
+                world.contains_resource::<NavCostmaps>(),
                 shared_costmaps::sync_costmaps,
-                drive::plan_routes,
-                // the camera image of the previous tick's Sense set
+            )
+            .add(navigators, drive::plan_routes)
+            // the camera image of the previous tick's Sense set
+            .add(
+                any_with::<RoadDetector>(world),
                 road_recognition::detect_roads,
             )
-                .chain()
-                .in_set(SimSet::Plan),
-        );
-        // All three write DriveCommand, each for the robots it drives (with a navigator, a road
-        // navigator, or a behaviour): navigators, then road navigators, then behaviours, the order
-        // they ran in before it was explicit. The systems stay in the order they were added in,
-        // which the executor's order of Control's other systems (walk_people) depends on.
-        schedule.add_systems(
-            (
-                behaviour::drive_behaviours,
-                drive::drive_navigators.before(road_drive::system::drive_road_navigators),
-                road_drive::system::drive_road_navigators.before(behaviour::drive_behaviours),
-                // a held command replaces theirs
-                held::apply_held_commands.after(behaviour::drive_behaviours),
-            )
-                .in_set(SimSet::Control),
-        );
+            .add_to(schedule, SimSet::Plan);
+        // All four write DriveCommand, each for the robots it drives (with a navigator, a road
+        // navigator, a behaviour, or a command held by the program), in this order.
+        Chained::new()
+            .add(navigators, drive::drive_navigators)
+            .add(road_navigators, road_drive::system::drive_road_navigators)
+            .add(any_with::<Behaviour>(world), behaviour::drive_behaviours)
+            // a held command replaces theirs
+            .add(any_with::<HeldCommand>(world), held::apply_held_commands)
+            .add_to(schedule, SimSet::Control);
     }
 }

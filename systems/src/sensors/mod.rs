@@ -17,7 +17,7 @@ pub use gps::{Gps, GpsFix, GpsReadings, GpsSpec};
 pub use laser::{Laser, LaserScan, LaserScans, LaserSpec, LaserTruth};
 pub use sonar::{SonarReadings, SonarSpec, SonarTruth, Sonars};
 
-use crate::core::{SimPlugin, SimSet};
+use crate::core::{Chained, SimPlugin, SimSet, any_with};
 use bevy_ecs::prelude::*;
 
 pub struct SensorsPlugin;
@@ -25,18 +25,17 @@ pub struct SensorsPlugin;
 impl SimPlugin for SensorsPlugin {
     fn build(&self, world: &mut World, schedule: &mut Schedule) {
         world.init_resource::<others::RobotOutlines>();
-        schedule.add_systems(
-            (
-                others::update_robot_outlines,
-                laser::sample_lasers,
-                sonar::sample_sonars,
-                encoder::sample_encoders,
-                gps::sample_gps,
-                compass::sample_compasses,
-                camera::sample_cameras,
-            )
-                .chain()
-                .in_set(SimSet::Sense),
-        );
+        let lasers = any_with::<Laser>(world);
+        let sonars = any_with::<Sonars>(world);
+        Chained::new()
+            // the outlines of the others are what lasers and sonars see besides walls
+            .add(lasers || sonars, others::update_robot_outlines)
+            .add(lasers, laser::sample_lasers)
+            .add(sonars, sonar::sample_sonars)
+            .add(any_with::<Encoder>(world), encoder::sample_encoders)
+            .add(any_with::<Gps>(world), gps::sample_gps)
+            .add(any_with::<Compass>(world), compass::sample_compasses)
+            .add(any_with::<Camera>(world), camera::sample_cameras)
+            .add_to(schedule, SimSet::Sense);
     }
 }

@@ -79,7 +79,9 @@ impl Buckets {
         if lo[0] > hi[0] {
             (lo, hi) = ([0.0; 2], [0.0; 2]);
         }
-        let most = (4 * placed.len()).max(4096) as f64;
+        // the grid is rebuilt every tick: its size follows the number of bodies, so a few robots
+        // on a large map do not pay for thousands of empty buckets
+        let most = (4 * placed.len()).max(64) as f64;
         self.side = BUCKET;
         while ((hi[0] - lo[0]) / self.side + 2.0) * ((hi[1] - lo[1]) / self.side + 2.0) > most {
             self.side *= 2.0;
