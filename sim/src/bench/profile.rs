@@ -29,6 +29,9 @@ pub struct ProfileOptions {
     /// Beams per scan of the swarm robots.
     #[arg(long, default_value_t = 180, requires = "robots")]
     pub beams: usize,
+    /// The swarm robots also localize with MCL (as `sim bench swarm --mcl`).
+    #[arg(long, requires = "robots")]
+    pub mcl: bool,
     /// Simulated seconds profiled, after the first tick (which builds the schedule).
     #[arg(long, default_value_t = 60.0)]
     pub duration: f64,
@@ -77,8 +80,13 @@ pub fn run_profile(o: &ProfileOptions) -> anyhow::Result<()> {
         Some(n) => {
             check_beams(o.beams)?;
             let grid = swarm_world()?;
-            let label = format!("swarm world, {n} robots, {} beams", o.beams);
-            (label, swarm_scenario(&grid, n, o.beams, o.duration + 1.0)?)
+            let mcl = if o.mcl { ", MCL" } else { "" };
+            let label = format!("swarm world, {n} robots, {} beams{mcl}", o.beams);
+            let mut sc = swarm_scenario(&grid, n, o.beams, o.duration + 1.0)?;
+            if o.mcl {
+                crate::bench::swarm::localize_with_mcl(&mut sc);
+            }
+            (label, sc)
         }
         None => {
             let sc = scenario_arg(o.scenario.as_deref())?;

@@ -3,6 +3,7 @@
 //! benchmark ranger (180 beams over 180°, 8 m) and a SICK LMS100 (1081 beams over 270°, 20 m).
 
 use crate::options::check_duration;
+use crate::scenario::localizers::{LocalizerConfig, LocalizerKind};
 use crate::scenario::resolve::default_diff_drive;
 use crate::scenario::{RecordConfig, RobotConfig, Scenario, assets_dir};
 use crate::{RunOptions, run_scenario};
@@ -11,8 +12,10 @@ use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
 use systems::body::{Footprint, Kinematics};
 use systems::core::{Pose2, stream_rng};
+use systems::localization::MclConfig;
+use systems::localization::mcl::InitialBelief;
 use systems::navigation::BehaviourKind;
-use systems::sensors::LaserSpec;
+use systems::sensors::{EncoderSpec, LaserSpec};
 use systems::world::{Cell, OccupancyGrid, load_map};
 
 /// `sim bench swarm`: real-time factor and rays/s for swarms of wandering robots with lasers at
@@ -38,6 +41,10 @@ pub struct SwarmOptions {
     /// (`sim::Simulation`, which `sim run` uses): measures what the facade costs.
     #[arg(long)]
     pub direct: bool,
+    /// Every robot also localizes with MCL on its laser and wheel encoders (AMCL's defaults:
+    /// 500 to 5000 particles, likelihood field, 60 beams), starting around its true pose.
+    #[arg(long)]
+    pub mcl: bool,
 }
 
 #[derive(Serialize)]
@@ -52,6 +59,8 @@ struct SwarmResult {
     threads: usize,
     /// "facade" (as `sim run`) or "schedule" (`--direct`).
     stepped_by: &'static str,
+    /// "mcl" with `--mcl`, else "none".
+    localizer: &'static str,
     sim_time_s: f64,
     wall_time_s: f64,
     real_time_factor: f64,
@@ -183,6 +192,26 @@ pub fn swarm_scenario(
     })
 }
 
+/// Gives every robot of `sc` wheel encoders and an MCL localizer with AMCL's defaults (500 to
+/// 5000 particles with KLD sampling, likelihood field, 60 beams, updates after 0.2 m or 30°),
+/// its particles drawn around the robot's start with AMCL's default initial spread (0.5 m, and
+/// π/12 in heading): the one-robot localization world of issue 52.
+pub fn localize_with_mcl(sc: &mut Scenario) {
+    for r in &mut sc.robots {
+        r.encoder = Some(EncoderSpec::default());
+        r.localizers = vec![LocalizerConfig {
+            name: "mcl".into(),
+            kind: LocalizerKind::Mcl(MclConfig {
+                init: InitialBelief::Gaussian {
+                    pose: r.start,
+                    sd: [0.5, 0.5, std::f64::consts::PI / 12.0],
+                },
+                ..MclConfig::default()
+            }),
+        }];
+    }
+}
+
 /// A `--beams` value: 2 to [`LaserSpec::MAX_BEAMS`] beams per scan.
 pub fn check_beams(beams: usize) -> anyhow::Result<()> {
     let max = LaserSpec::MAX_BEAMS;
@@ -213,7 +242,11 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     let mut runs = Vec::with_capacity(o.beams.len() * o.robots.len());
     for &beams in &o.beams {
         for &n in &o.robots {
-            runs.push((beams, swarm_scenario(&grid, n, beams, o.duration)?));
+            let mut sc = swarm_scenario(&grid, n, beams, o.duration)?;
+            if o.mcl {
+                localize_with_mcl(&mut sc);
+            }
+            runs.push((beams, sc));
         }
     }
     let b = grid.bounds();
@@ -224,6 +257,9 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     );
     if !o.json {
         println!("swarm benchmark on {map}, lasers at 10 Hz, dt 0.05 s");
+        if o.mcl {
+            println!("every robot localizes with MCL (500 to 5000 particles, AMCL's defaults)");
+        }
         println!("machine: {}", crate::bench::machine::describe());
         println!(
             "{:>7} {:>6} {:>9} {:>10} {:>12} {:>14}",
@@ -263,6 +299,7 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
             dt_s: sc.dt,
             threads,
             stepped_by: if o.direct { "schedule" } else { "facade" },
+            localizer: if o.mcl { "mcl" } else { "none" },
             sim_time_s,
             wall_time_s,
             real_time_factor: sim_time_s / wall_time_s.max(1e-9),
@@ -322,6 +359,34 @@ mod tests {
         let again = swarm_scenario(&g, 6, 180, 1.0).expect("six robots fit");
         let starts = |s: &Scenario| s.robots.iter().map(|r| r.start).collect::<Vec<_>>();
         assert_eq!(starts(&sc), starts(&again), "placement is seeded");
+    }
+
+    /// With `--mcl`, every wandering robot localizes from its start and tracks itself on the
+    /// hospital: the benchmark times a working localizer, not one that is lost.
+    #[test]
+    fn swarm_robots_with_mcl_track_their_poses() {
+        let g = load_map(&assets_dir().join("maps/hospital/hospital.yaml")).unwrap();
+        let mut sc = swarm_scenario(&g, 2, 180, 20.0).expect("two robots fit");
+        localize_with_mcl(&mut sc);
+        let out = run_scenario(
+            &sc,
+            &RunOptions {
+                rrd: None,
+                threads: 1,
+                progress: false,
+                trajectory_period: None,
+            },
+        )
+        .unwrap();
+        for r in &out.summary.robots {
+            let m = &r.localization["mcl"];
+            assert!(m.estimates >= 20, "{}: {} estimates", r.name, m.estimates);
+            // the start's spread (0.5 m) settles within a few updates
+            let ate = m.ate_rmse_m.expect("estimates were judged");
+            assert!(ate < 0.5, "{}: ATE {ate} m", r.name);
+            let tracked = m.tracked_fraction.expect("estimates were judged");
+            assert!(tracked >= 0.9, "{}: tracked {tracked}", r.name);
+        }
     }
 
     #[test]
