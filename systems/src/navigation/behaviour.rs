@@ -161,6 +161,10 @@ impl Behaviour {
     }
 }
 
+/// Robots from which behaviours run on the kernel pool: about a microsecond each (the laser's
+/// sectors and a heading), so a few do not pay for the hand-over.
+const PARALLEL_ROBOTS: usize = 32;
+
 /// Control: every robot's behaviour produces its drive command, in parallel on the kernel pool
 /// (each behaviour draws only from its own random stream, so threads do not change results).
 #[allow(clippy::type_complexity)]
@@ -179,17 +183,21 @@ pub fn drive_behaviours(
     let now = clock.start();
     let mut jobs = memory.take();
     jobs.extend(robots.iter_mut());
-    pool.for_each(&mut jobs, |(b, belief, kin, cmd, laser)| {
-        if let Some((laser, scans)) = laser {
-            if let Some(scan) = scans.scans.last() {
-                b.sectors
-                    .get_or_insert_with(SectorRanges::default)
-                    .update(scan, &laser.spec.mount);
-            } else if !laser.enabled {
-                b.sectors = None;
+    pool.for_each_from(
+        PARALLEL_ROBOTS,
+        &mut jobs,
+        |(b, belief, kin, cmd, laser)| {
+            if let Some((laser, scans)) = laser {
+                if let Some(scan) = scans.scans.last() {
+                    b.sectors
+                        .get_or_insert_with(SectorRanges::default)
+                        .update(scan, &laser.spec.mount);
+                } else if !laser.enabled {
+                    b.sectors = None;
+                }
             }
-        }
-        **cmd = b.command(&belief.pose, now, kin);
-    });
+            **cmd = b.command(&belief.pose, now, kin);
+        },
+    );
     memory.keep(jobs);
 }
