@@ -1,4 +1,4 @@
-//! A tick of a running world allocates nothing of its own (issue 52): every system keeps its
+//! A tick of a running world allocates nothing of its own: every system keeps its
 //! scratch space and its list of jobs from tick to tick, so a small world's tick is not paid in
 //! `malloc`. This binary's global allocator sees every allocation made during the counted ticks
 //! (after the first ones, which size the scratch space and let each sensor fire) and sorts it by

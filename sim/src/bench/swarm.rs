@@ -195,7 +195,7 @@ pub fn swarm_scenario(
 /// Gives every robot of `sc` wheel encoders and an MCL localizer with AMCL's defaults (500 to
 /// 5000 particles with KLD sampling, likelihood field, 60 beams, updates after 0.2 m or 30°),
 /// its particles drawn around the robot's start with AMCL's default initial spread (0.5 m, and
-/// π/12 in heading): the one-robot localization world of issue 52.
+/// π/12 in heading): a one-robot world with a working localizer, as AMCL users run it.
 pub fn localize_with_mcl(sc: &mut Scenario) {
     for r in &mut sc.robots {
         r.encoder = Some(EncoderSpec::default());

@@ -46,6 +46,9 @@ pub(super) fn attach_estimators(
     scenario: &Scenario,
     estimators: Vec<(String, String, Filter)>,
 ) -> Result<(), SimError> {
+    if estimators.is_empty() {
+        return Ok(());
+    }
     for (robot, name, filter) in estimators {
         let (_, e) = robot_entity(sim, scenario, &robot)?;
         let world = &mut sim.world;

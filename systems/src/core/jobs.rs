@@ -46,10 +46,15 @@ impl JobMemory {
         if size == 0 {
             return;
         }
+        // a vector's buffer always has a valid layout and a non-null address; were it otherwise,
+        // the vector would simply be dropped
+        let Ok(layout) = Layout::from_size_align(size, align_of::<T>()) else {
+            return;
+        };
         let mut jobs = ManuallyDrop::new(jobs);
-        let layout = Layout::from_size_align(size, align_of::<T>())
-            .expect("a vector's buffer has a valid layout");
-        let ptr = NonNull::new(jobs.as_mut_ptr().cast::<u8>()).expect("a vector's buffer");
+        let Some(ptr) = NonNull::new(jobs.as_mut_ptr().cast::<u8>()) else {
+            return;
+        };
         self.take::<u8>(); // frees a block kept before, if any
         self.block = Some((ptr, layout));
     }

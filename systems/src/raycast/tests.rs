@@ -23,6 +23,20 @@ struct Map {
 }
 
 impl Map {
+    /// The bundled hospital map, tiled `tx` × `ty`.
+    fn hospital(tx: usize, ty: usize) -> Map {
+        let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
+        let grid = crate::world::load_map(&path)
+            .expect("the hospital map loads")
+            .tiled(tx, ty);
+        Map {
+            w: grid.width,
+            h: grid.height,
+            res: grid.resolution as f32,
+            origin: [grid.origin[0] as f32, grid.origin[1] as f32],
+            occ: grid.obstacles(),
+        }
+    }
     fn dda(&self, p: [f32; 2], a: f32, max: f32) -> f32 {
         cast_dda(self.w, self.h, self.res, self.origin, &self.occ, p, a, max)
     }
@@ -635,17 +649,7 @@ fn a_ray_along_a_cell_boundary_beside_a_wall_ends() {
 /// (a wall met at hundredths of a degree) that land a few millimetres away.
 #[test]
 fn single_rays_on_a_large_map_agree_with_dda_to_millimetres() {
-    let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
-    let grid = crate::world::load_map(&path)
-        .expect("the hospital map loads")
-        .tiled(2, 1);
-    let m = Map {
-        w: grid.width,
-        h: grid.height,
-        res: grid.resolution as f32,
-        origin: [grid.origin[0] as f32, grid.origin[1] as f32],
-        occ: grid.obstacles(),
-    };
+    let m = Map::hospital(2, 1);
     let rm = m.raymap();
     let mut rng = XorShift(11);
     let (mut corners, mut grazing, mut mismatches) = (0, 0, 0);
@@ -675,16 +679,7 @@ fn single_rays_on_a_large_map_agree_with_dda_to_millimetres() {
 /// ranges from zero to infinite.
 #[test]
 fn single_rays_match_the_plain_walk_to_the_bit() {
-    let path = crate::core::source::source_path("assets/maps/hospital/hospital.yaml");
-    let grid = crate::world::load_map(&path).expect("the hospital map loads");
-    let hospital = Map {
-        w: grid.width,
-        h: grid.height,
-        res: grid.resolution as f32,
-        origin: [grid.origin[0] as f32, grid.origin[1] as f32],
-        occ: grid.obstacles(),
-    };
-    for m in [hospital, random_map(13)] {
+    for m in [Map::hospital(1, 1), random_map(13)] {
         let rm = m.raymap();
         let mut rng = XorShift(31);
         let (wf, hf) = (m.w as f32 * m.res, m.h as f32 * m.res);
