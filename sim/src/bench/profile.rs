@@ -29,9 +29,16 @@ pub struct ProfileOptions {
     /// Beams per scan of the swarm robots.
     #[arg(long, default_value_t = 180, requires = "robots")]
     pub beams: usize,
-    /// The swarm robots also localize with MCL (as `sim bench swarm --mcl`).
-    #[arg(long, requires = "robots")]
-    pub mcl: bool,
+    /// The swarm robots also localize with MCL, with AMCL's defaults or sim's (as
+    /// `sim bench swarm --mcl`).
+    #[arg(
+        long,
+        requires = "robots",
+        num_args = 0..=1,
+        default_missing_value = "amcl",
+        value_name = "DEFAULTS"
+    )]
+    pub mcl: Option<crate::bench::swarm::MclDefaults>,
     /// Simulated seconds profiled, after the first tick (which builds the schedule).
     #[arg(long, default_value_t = 60.0)]
     pub duration: f64,
@@ -80,11 +87,14 @@ pub fn run_profile(o: &ProfileOptions) -> anyhow::Result<()> {
         Some(n) => {
             check_beams(o.beams)?;
             let grid = swarm_world()?;
-            let mcl = if o.mcl { ", MCL" } else { "" };
+            let mcl = match o.mcl {
+                Some(d) => format!(", MCL with {d:?} defaults"),
+                None => String::new(),
+            };
             let label = format!("swarm world, {n} robots, {} beams{mcl}", o.beams);
             let mut sc = swarm_scenario(&grid, n, o.beams, o.duration + 1.0)?;
-            if o.mcl {
-                crate::bench::swarm::localize_with_mcl(&mut sc);
+            if let Some(d) = o.mcl {
+                crate::bench::swarm::localize_with_mcl(&mut sc, d);
             }
             (label, sc)
         }

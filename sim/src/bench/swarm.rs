@@ -41,10 +41,38 @@ pub struct SwarmOptions {
     /// (`sim::Simulation`, which `sim run` uses): measures what the facade costs.
     #[arg(long)]
     pub direct: bool,
-    /// Every robot also localizes with MCL on its laser and wheel encoders (AMCL's defaults:
-    /// 500 to 5000 particles, likelihood field, 60 beams), starting around its true pose.
-    #[arg(long)]
-    pub mcl: bool,
+    /// Every robot also localizes with MCL on its laser and wheel encoders, starting around
+    /// its true pose, with ROS AMCL's parameter defaults (`amcl`, the default: 100 to 5000
+    /// particles, 30 beams, resampling every second update) or sim's (`sim`: 500 to 5000
+    /// particles, 60 beams, the scan proposal and its challenge).
+    #[arg(long, num_args = 0..=1, default_missing_value = "amcl", value_name = "DEFAULTS")]
+    pub mcl: Option<MclDefaults>,
+}
+
+/// Whose parameter defaults the benchmark's MCL takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MclDefaults {
+    /// ROS AMCL's ([`MclConfig::amcl`]).
+    Amcl,
+    /// sim's own ([`MclConfig::default`]).
+    Sim,
+}
+
+impl MclDefaults {
+    pub fn config(self) -> MclConfig {
+        match self {
+            MclDefaults::Amcl => MclConfig::amcl(),
+            MclDefaults::Sim => MclConfig::default(),
+        }
+    }
+
+    /// The benchmark row's `localizer`.
+    pub fn label(self) -> &'static str {
+        match self {
+            MclDefaults::Amcl => "mcl-amcl",
+            MclDefaults::Sim => "mcl-sim",
+        }
+    }
 }
 
 #[derive(Serialize)]
@@ -59,7 +87,7 @@ struct SwarmResult {
     threads: usize,
     /// "facade" (as `sim run`) or "schedule" (`--direct`).
     stepped_by: &'static str,
-    /// "mcl" with `--mcl`, else "none".
+    /// "mcl-amcl" or "mcl-sim" with `--mcl`, else "none".
     localizer: &'static str,
     sim_time_s: f64,
     wall_time_s: f64,
@@ -196,7 +224,7 @@ pub fn swarm_scenario(
 /// 5000 particles with KLD sampling, likelihood field, 60 beams, updates after 0.2 m or 30°),
 /// its particles drawn around the robot's start with AMCL's default initial spread (0.5 m, and
 /// π/12 in heading): a one-robot world with a working localizer, as AMCL users run it.
-pub fn localize_with_mcl(sc: &mut Scenario) {
+pub fn localize_with_mcl(sc: &mut Scenario, defaults: MclDefaults) {
     for r in &mut sc.robots {
         r.encoder = Some(EncoderSpec::default());
         r.localizers = vec![LocalizerConfig {
@@ -206,7 +234,7 @@ pub fn localize_with_mcl(sc: &mut Scenario) {
                     pose: r.start,
                     sd: [0.5, 0.5, std::f64::consts::PI / 12.0],
                 },
-                ..MclConfig::default()
+                ..defaults.config()
             }),
         }];
     }
@@ -243,8 +271,8 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     for &beams in &o.beams {
         for &n in &o.robots {
             let mut sc = swarm_scenario(&grid, n, beams, o.duration)?;
-            if o.mcl {
-                localize_with_mcl(&mut sc);
+            if let Some(d) = o.mcl {
+                localize_with_mcl(&mut sc, d);
             }
             runs.push((beams, sc));
         }
@@ -257,8 +285,14 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     );
     if !o.json {
         println!("swarm benchmark on {map}, lasers at 10 Hz, dt 0.05 s");
-        if o.mcl {
-            println!("every robot localizes with MCL (500 to 5000 particles, AMCL's defaults)");
+        match o.mcl {
+            Some(MclDefaults::Amcl) => println!(
+                "every robot localizes with MCL, ROS AMCL's defaults (100 to 5000 particles, 30 beams)"
+            ),
+            Some(MclDefaults::Sim) => println!(
+                "every robot localizes with MCL, sim's defaults (500 to 5000 particles, 60 beams, scan proposal)"
+            ),
+            None => {}
         }
         println!("machine: {}", crate::bench::machine::describe());
         println!(
@@ -299,7 +333,7 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
             dt_s: sc.dt,
             threads,
             stepped_by: if o.direct { "schedule" } else { "facade" },
-            localizer: if o.mcl { "mcl" } else { "none" },
+            localizer: o.mcl.map_or("none", MclDefaults::label),
             sim_time_s,
             wall_time_s,
             real_time_factor: sim_time_s / wall_time_s.max(1e-9),
@@ -367,7 +401,7 @@ mod tests {
     fn swarm_robots_with_mcl_track_their_poses() {
         let g = load_map(&assets_dir().join("maps/hospital/hospital.yaml")).unwrap();
         let mut sc = swarm_scenario(&g, 2, 180, 20.0).expect("two robots fit");
-        localize_with_mcl(&mut sc);
+        localize_with_mcl(&mut sc, MclDefaults::Amcl);
         let out = run_scenario(
             &sc,
             &RunOptions {

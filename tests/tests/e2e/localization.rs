@@ -253,6 +253,30 @@ fn localizer_errors_name_the_key() {
         &["kld_z", "probability"],
     );
     expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"mcl\"\nresample_interval = 2000000"),
+        &["resample_interval", "[1, 1000000]"],
+    );
+    expect_error(
+        &with_localizer("[[robots.localization]]\ntype = \"markov_grid\"\nresample_interval = 2"),
+        &["resample_interval", "does not apply"],
+    );
+    // AMCL's resampling every second update; 0 is the selective rule
+    for (given, expected) in [
+        ("resample_interval = 2", 2),
+        ("resample_interval = 0", 0),
+        ("", 0),
+    ] {
+        let sc = scenario(&with_localizer(&format!(
+            "[[robots.localization]]\ntype = \"mcl\"\n{given}"
+        )));
+        match &sc.robots[0].localizers[0].kind {
+            sim::scenario::localizers::LocalizerKind::Mcl(c) => {
+                assert_eq!(c.resample_interval, expected, "{given}")
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    expect_error(
         &with_localizer("[[robots.localization]]\ntype = \"mcl\"\ninit_sd = [0.1, 0.1, 0.1]"),
         &["init_sd", "init = \"pose\""],
     );

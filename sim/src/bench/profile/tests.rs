@@ -73,7 +73,7 @@ fn bad_options_are_errors() {
         scenario: None,
         robots: Some(1),
         beams: 1,
-        mcl: false,
+        mcl: None,
         duration: 1.0,
         json: true,
     };

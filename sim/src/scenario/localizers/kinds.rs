@@ -57,6 +57,16 @@ pub(super) fn resolve_mcl(
         kld_z,
         update_min_d: f.nonneg("update_min_d", l.update_min_d, d.update_min_d)?,
         update_min_a: f.nonneg("update_min_a", l.update_min_a, d.update_min_a)?,
+        resample_interval: match l.resample_interval {
+            Some(0) => 0,
+            _ => f.count(
+                "resample_interval",
+                l.resample_interval,
+                d.resample_interval as usize,
+                1,
+                1_000_000,
+            )? as u64,
+        },
         max_beams: f.max_beams(d.max_beams)?,
         model: match l.model {
             Some(LaserModelType::Beam) => LaserModel::Beam,

@@ -61,6 +61,11 @@ pub struct MclConfig {
     pub kld_z: f64,
     pub update_min_d: f64,
     pub update_min_a: f64,
+    /// Resample every this many updates (AMCL's `resample_interval`), or, with 0, only when
+    /// the weights have degenerated (N_eff < N/2). AMCL's weights, 1 + Σ pz³, are flat, so
+    /// N_eff rarely falls below N/2: gated resampling keeps the cloud (and the KLD count) as
+    /// wide as motion noise makes it, resampling every update or two lets it shrink.
+    pub resample_interval: u64,
     pub max_beams: usize,
     pub model: LaserModel,
     pub laser: LaserModelParams,
@@ -99,6 +104,7 @@ impl Default for MclConfig {
             kld_z: 0.99,
             update_min_d: 0.2,
             update_min_a: std::f64::consts::PI / 6.0,
+            resample_interval: 0,
             max_beams: 60,
             model: LaserModel::LikelihoodField,
             laser: LaserModelParams::default(),
@@ -112,6 +118,25 @@ impl Default for MclConfig {
             challenge_fraction: 0.1,
             init: InitialBelief::Global,
             bins: BinSize::default(),
+        }
+    }
+}
+
+impl MclConfig {
+    /// ROS AMCL's parameter defaults: 100 to 5000 particles, 30 beams, resampling every second
+    /// update, no random particles (its recovery averages are 0) and therefore neither the scan
+    /// proposal nor its challenge, which AMCL does not have.
+    pub fn amcl() -> Self {
+        MclConfig {
+            min_particles: 100,
+            max_particles: 5000,
+            resample_interval: 2,
+            max_beams: 30,
+            recovery_alpha_slow: 0.0,
+            recovery_alpha_fast: 0.0,
+            injection_candidates: 0,
+            challenge_every: 0,
+            ..MclConfig::default()
         }
     }
 }
@@ -401,6 +426,14 @@ impl Mcl {
         self.resamplings += 1;
     }
 
+    /// Whether this update resamples (see [`MclConfig::resample_interval`]).
+    fn resampling_due(&self, n_eff: f64) -> bool {
+        match self.config.resample_interval {
+            0 => n_eff < self.len() as f64 / 2.0,
+            k => (self.updates + 1).is_multiple_of(k),
+        }
+    }
+
     /// The odometry pose of the last update.
     pub fn last_odometry(&self) -> Option<Pose2> {
         self.last_odom
@@ -468,7 +501,7 @@ impl MapLocalizer for Mcl {
 
         if let Some(pool) = challenger {
             self.resample(map, self.config.challenge_fraction, Some(&pool));
-        } else if n_eff < self.len() as f64 / 2.0 || p_inject > 0.0 {
+        } else if self.resampling_due(n_eff) || p_inject > 0.0 {
             // Unlike AMCL, the averages are not reset after an injection (Table 8.3 has no
             // reset): AMCL's reset ends the injection after one burst of a few percent, which
             // rarely finds a kidnapped robot; here random particles keep coming while the

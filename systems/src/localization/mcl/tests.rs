@@ -52,6 +52,47 @@ fn tracks_from_a_gaussian_around_the_start() {
     assert!(mcl.len() < 3500, "{}", mcl.len());
 }
 
+/// AMCL's defaults resample every second update whatever the weights, and still track along
+/// the corridor; the default (selective) filter resamples only when the weights degenerate.
+#[test]
+fn amcl_s_defaults_resample_every_second_update_and_track() {
+    let map = hospital();
+    let start = Pose2::new(2.2, 16.0, 0.0);
+    let init = InitialBelief::Gaussian {
+        pose: Pose2::new(2.5, 15.8, 0.1),
+        sd: [0.3, 0.3, 0.1],
+    };
+    let run = |config: MclConfig| {
+        let mut mcl = Mcl::new(config, &map, stream_rng(1, "test", "mcl"));
+        let mut errors = Vec::new();
+        drive(&map, &CORRIDOR, start.theta, 1, |truth, odom, scan| {
+            let beams = BeamSubset::from_scan(scan, &Pose2::IDENTITY, mcl.config.max_beams);
+            if mcl.update(&map, &beams, odom) {
+                errors.push(error(&MapLocalizer::estimate(&mcl).unwrap(), truth));
+            }
+        });
+        let rms =
+            (errors[5..].iter().map(|e| e.0 * e.0).sum::<f64>() / (errors.len() - 5) as f64).sqrt();
+        (mcl.updates, mcl.resamplings, rms)
+    };
+    let (updates, resamplings, rms) = run(MclConfig {
+        init,
+        ..MclConfig::amcl()
+    });
+    assert!(updates > 100, "{updates}");
+    assert_eq!(resamplings, updates / 2, "{updates} updates");
+    assert!(rms < 0.3, "AMCL's defaults: rms {rms} m");
+    let (updates, resamplings, _) = run(MclConfig {
+        init,
+        max_beams: 30,
+        ..MclConfig::default()
+    });
+    assert!(
+        resamplings < updates / 2,
+        "selective: {resamplings} of {updates}"
+    );
+}
+
 #[test]
 fn converges_from_global_initialisation() {
     let map = hospital();
