@@ -1,6 +1,8 @@
 //! `sim bench swarm`: real-time factor and rays/s for swarms of wandering robots, each with a
-//! laser at 10 Hz, on the hospital map tiled 4 × 4 (so the swarm does not jam). Two lasers: Stage's
-//! benchmark ranger (180 beams over 180°, 8 m) and a SICK LMS100 (1081 beams over 270°, 20 m).
+//! laser at 10 Hz, on the hospital map tiled 4 × 4 (so the swarm does not jam), or, with
+//! `--per-hospital`, tiled with the robot count so the density stays constant. Two lasers:
+//! Stage's benchmark ranger (180 beams over 180°, 8 m) and a SICK LMS100 (1081 beams over 270°,
+//! 20 m).
 
 use crate::options::check_duration;
 use crate::scenario::localizers::{LocalizerConfig, LocalizerKind};
@@ -47,6 +49,12 @@ pub struct SwarmOptions {
     /// particles, 60 beams, the scan proposal and its challenge).
     #[arg(long, num_args = 0..=1, default_missing_value = "amcl", value_name = "DEFAULTS")]
     pub mcl: Option<MclDefaults>,
+    /// Constant density: each population gets the hospital tiled k × k, k = ⌈√(robots / N)⌉,
+    /// so every copy of the hospital holds about N robots (exactly N when robots / N is a
+    /// square), instead of one 4 × 4 map for all. The cost per robot-step should then not grow
+    /// with the robot count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..=400))]
+    pub per_hospital: Option<u64>,
 }
 
 /// Whose parameter defaults the benchmark's MCL takes.
@@ -93,6 +101,8 @@ struct SwarmResult {
     wall_time_s: f64,
     real_time_factor: f64,
     rays_per_s: f64,
+    /// Wall time per robot and tick (µs).
+    us_per_robot_step: f64,
     map: String,
 }
 
@@ -251,9 +261,58 @@ pub fn check_beams(beams: usize) -> anyhow::Result<()> {
 
 /// The benchmark world: the hospital tiled 4 × 4.
 pub fn swarm_world() -> anyhow::Result<OccupancyGrid> {
-    let path = assets_dir().join("maps/hospital/hospital.yaml");
-    let g = load_map(&path)?;
-    Ok(g.tiled(4, 4))
+    Ok(hospital()?.tiled(4, 4))
+}
+
+fn hospital() -> anyhow::Result<OccupancyGrid> {
+    Ok(load_map(&assets_dir().join("maps/hospital/hospital.yaml"))?)
+}
+
+/// Copies of the hospital per side for `robots` robots at `per_hospital` robots per copy.
+pub fn tiles_per_side(robots: usize, per_hospital: usize) -> usize {
+    let copies = robots.div_ceil(per_hospital.max(1));
+    let mut k = (copies as f64).sqrt() as usize;
+    while k * k < copies {
+        k += 1;
+    }
+    k.max(1)
+}
+
+/// The map of one population: the 4 × 4 world, or the hospital tiled with the robot count.
+struct SwarmMaps {
+    hospital: OccupancyGrid,
+    fixed: Option<OccupancyGrid>,
+    per_hospital: Option<usize>,
+}
+
+impl SwarmMaps {
+    fn new(per_hospital: Option<usize>) -> anyhow::Result<Self> {
+        let hospital = hospital()?;
+        let fixed = per_hospital.is_none().then(|| hospital.tiled(4, 4));
+        Ok(SwarmMaps {
+            hospital,
+            fixed,
+            per_hospital,
+        })
+    }
+
+    /// The grid and its description for `robots` robots.
+    fn for_robots(&self, robots: usize) -> (std::borrow::Cow<'_, OccupancyGrid>, String) {
+        let (grid, k) = match (&self.fixed, self.per_hospital) {
+            (Some(g), _) => (std::borrow::Cow::Borrowed(g), 4),
+            (None, per) => {
+                let k = tiles_per_side(robots, per.unwrap_or(1));
+                (std::borrow::Cow::Owned(self.hospital.tiled(k, k)), k)
+            }
+        };
+        let b = grid.bounds();
+        let map = format!(
+            "hospital tiled {k}x{k} ({:.0} x {:.0} m)",
+            b[2] - b[0],
+            b[3] - b[1]
+        );
+        (grid, map)
+    }
 }
 
 pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
@@ -264,27 +323,32 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     for &b in &o.beams {
         check_beams(b)?;
     }
-    let grid = swarm_world()?;
-    // every population is placed before the first one runs, so one that does not fit fails
-    // at once
-    let mut runs = Vec::with_capacity(o.beams.len() * o.robots.len());
-    for &beams in &o.beams {
-        for &n in &o.robots {
-            let mut sc = swarm_scenario(&grid, n, beams, o.duration)?;
-            if let Some(d) = o.mcl {
-                localize_with_mcl(&mut sc, d);
+    let per_hospital = o.per_hospital.map(|n| n as usize);
+    let maps = SwarmMaps::new(per_hospital)?;
+    // every population is placed before the first one runs, so one that does not fit fails at
+    // once; at constant density one copy of the hospital must hold its share
+    match per_hospital {
+        Some(per) => {
+            swarm_scenario(&maps.hospital, per, 180, o.duration)
+                .map_err(|e| anyhow::anyhow!("--per-hospital {per}: {e}"))?;
+        }
+        None => {
+            let (grid, _) = maps.for_robots(0);
+            for &n in &o.robots {
+                swarm_scenario(&grid, n, 180, o.duration)?;
             }
-            runs.push((beams, sc));
         }
     }
-    let b = grid.bounds();
-    let map = format!(
-        "hospital tiled 4x4 ({:.0} x {:.0} m)",
-        b[2] - b[0],
-        b[3] - b[1]
-    );
     if !o.json {
-        println!("swarm benchmark on {map}, lasers at 10 Hz, dt 0.05 s");
+        match per_hospital {
+            Some(per) => println!(
+                "swarm benchmark at {per} robots per copy of the hospital, lasers at 10 Hz, dt 0.05 s"
+            ),
+            None => println!(
+                "swarm benchmark on {}, lasers at 10 Hz, dt 0.05 s",
+                maps.for_robots(0).1
+            ),
+        }
         match o.mcl {
             Some(MclDefaults::Amcl) => println!(
                 "every robot localizes with MCL, ROS AMCL's defaults (100 to 5000 particles, 30 beams)"
@@ -296,11 +360,21 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
         }
         println!("machine: {}", crate::bench::machine::describe());
         println!(
-            "{:>7} {:>6} {:>9} {:>10} {:>12} {:>14}",
-            "robots", "beams", "sim s", "wall s", "× real time", "rays/s"
+            "{:>7} {:>6} {:>9} {:>10} {:>12} {:>14} {:>12}  map",
+            "robots", "beams", "sim s", "wall s", "× real time", "rays/s", "µs/robot-step"
         );
     }
-    for (beams, sc) in runs {
+    let runs = o
+        .beams
+        .iter()
+        .flat_map(|&b| o.robots.iter().map(move |&n| (b, n)));
+    for (beams, n) in runs {
+        let (grid, map) = maps.for_robots(n);
+        let mut sc = swarm_scenario(&grid, n, beams, o.duration)?;
+        drop(grid);
+        if let Some(d) = o.mcl {
+            localize_with_mcl(&mut sc, d);
+        }
         let spec = swarm_laser(beams);
         let (sim_time_s, wall_time_s) = if o.direct {
             run_direct(&sc, o.threads)?
@@ -338,14 +412,23 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
             wall_time_s,
             real_time_factor: sim_time_s / wall_time_s.max(1e-9),
             rays_per_s: rays / wall_time_s.max(1e-9),
-            map: map.clone(),
+            us_per_robot_step: wall_time_s * 1e6 * sc.dt
+                / (sim_time_s.max(1e-9) * sc.robots.len() as f64),
+            map,
         };
         if o.json {
             println!("{}", crate::bench::machine::json_line(&r)?);
         } else {
             println!(
-                "{:>7} {:>6} {:>9.1} {:>10.2} {:>12.1} {:>14.3e}",
-                r.robots, r.beams, r.sim_time_s, r.wall_time_s, r.real_time_factor, r.rays_per_s
+                "{:>7} {:>6} {:>9.1} {:>10.2} {:>12.1} {:>14.3e} {:>12.2}  {}",
+                r.robots,
+                r.beams,
+                r.sim_time_s,
+                r.wall_time_s,
+                r.real_time_factor,
+                r.rays_per_s,
+                r.us_per_robot_step,
+                r.map
             );
         }
     }
@@ -420,6 +503,23 @@ mod tests {
             assert!(ate < 0.5, "{}: ATE {ate} m", r.name);
             let tracked = m.tracked_fraction.expect("estimates were judged");
             assert!(tracked >= 0.9, "{}: tracked {tracked}", r.name);
+        }
+    }
+
+    /// Constant density: the copies of the hospital per side grow with the square root of the
+    /// robot count, exactly when the count over the density is a square.
+    #[test]
+    fn tiles_grow_with_the_robot_count() {
+        for (robots, per, k) in [
+            (1, 100, 1),
+            (100, 100, 1),
+            (101, 100, 2),
+            (400, 100, 2),
+            (1000, 100, 4),
+            (10_000, 100, 10),
+            (3, 1, 2),
+        ] {
+            assert_eq!(tiles_per_side(robots, per), k, "{robots} at {per}");
         }
     }
 

@@ -115,6 +115,51 @@ fn bench_swarm_prints_one_row_per_population_and_laser() {
     assert_eq!(direct[0]["stepped_by"], "schedule");
 }
 
+/// At constant density each population gets its own tiling of the hospital, and the rows say
+/// which; `--mcl` names whose defaults the localizers took.
+#[test]
+fn bench_swarm_at_constant_density_tiles_the_map_with_the_robot_count() {
+    let fields = ["robots", "real_time_factor", "us_per_robot_step"];
+    let rows = bench_rows(
+        &[
+            "bench",
+            "swarm",
+            "--json",
+            "--robots",
+            "2,5",
+            "--beams",
+            "30",
+            "--duration",
+            "0.2",
+            "--per-hospital",
+            "2",
+        ],
+        &fields,
+    );
+    let maps: Vec<&str> = rows.iter().map(|r| r["map"].as_str().unwrap()).collect();
+    assert!(maps[0].starts_with("hospital tiled 1x1"), "{maps:?}");
+    // 5 robots at 2 per copy: 3 copies, so 2 x 2
+    assert!(maps[1].starts_with("hospital tiled 2x2"), "{maps:?}");
+    let mcl = |defaults: Option<&str>| {
+        let mut args = vec![
+            "bench",
+            "swarm",
+            "--json",
+            "--robots",
+            "1",
+            "--beams",
+            "30",
+            "--duration",
+            "0.2",
+            "--mcl",
+        ];
+        args.extend(defaults);
+        bench_rows(&args, &["real_time_factor"])[0]["localizer"].clone()
+    };
+    assert_eq!(mcl(None), "mcl-amcl");
+    assert_eq!(mcl(Some("sim")), "mcl-sim");
+}
+
 /// Options the swarm benchmark cannot honour are refused before anything runs, naming the
 /// option, instead of being clamped or running forever.
 #[test]
@@ -131,6 +176,9 @@ fn bench_swarm_refuses_bad_options() {
         (&["--beams", "1"], &["--beams", "2 to 20000", "got 1"]),
         (&["--beams", "180,20001"], &["--beams", "got 20001"]),
         (&["--robots", "10,0"], &["--robots", "at least 1", "got 0"]),
+        (&["--per-hospital", "0"], &["--per-hospital", "0"]),
+        (&["--per-hospital", "100000"], &["--per-hospital", "100000"]),
+        (&["--mcl", "ros"], &["--mcl", "ros", "amcl"]),
         (
             &["--robots", "1000000"],
             &["--robots 1000000", "free floor"],
