@@ -62,12 +62,15 @@ impl MatchedMap {
         let Some([c0, r0, c1, r1]) = stats.window else {
             return;
         };
+        // only the cells the scan updated changed: the window's others keep their probability
         let w = self.prob.width;
         let lo = self.map.log_odds();
         for r in r0..r1 {
             for c in c0..c1 {
                 let i = r * w + c;
-                self.prob.p[i] = probability(lo[i]);
+                if self.map.updated_by_last_scan(i) {
+                    self.prob.p[i] = probability(lo[i]);
+                }
             }
         }
         if let Some(p) = &mut self.pyramid {
@@ -121,4 +124,40 @@ pub fn base_points(scan: &LaserScan, mount: &Pose2, stride: usize) -> Vec<[f32; 
             [p[0] as f32, p[1] as f32]
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::localization::test_drive::{CORRIDOR, drive, hospital};
+
+    /// The mirror updated cell by cell (only what each scan touched) equals the probabilities
+    /// recomputed from the whole log-odds map, to the bit, through a drive that also grows the
+    /// map.
+    #[test]
+    fn the_mirror_equals_the_plain_recomputation() {
+        let map = hospital();
+        let mut m = MatchedMap::new(0.05, OccupancyParams::slam(), 3);
+        let mut step = 0;
+        drive(&map, &CORRIDOR, 0.0, 7, |truth, _, scan| {
+            step += 1;
+            if step % 3 == 0 {
+                m.insert(truth, scan);
+            }
+        });
+        assert!(m.scans > 50, "{} scans", m.scans);
+        let plain = m.log_odds().to_prob_grid();
+        assert_eq!(
+            (m.prob().width, m.prob().height),
+            (plain.width, plain.height)
+        );
+        let differ = m
+            .prob()
+            .p
+            .iter()
+            .zip(&plain.p)
+            .filter(|(a, b)| a.to_bits() != b.to_bits())
+            .count();
+        assert_eq!(differ, 0, "cells whose probability differs");
+    }
 }

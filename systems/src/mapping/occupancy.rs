@@ -190,6 +190,13 @@ impl LogOddsMap {
         stats
     }
 
+    /// Whether the last inserted scan updated cell `i` (row-major): the only cells whose log
+    /// odds that insertion may have changed.
+    #[inline]
+    pub fn updated_by_last_scan(&self, i: usize) -> bool {
+        self.stamps[i] == self.scan_id
+    }
+
     /// A new update stamp; on wrap-around every stamp is reset so none equals the new one.
     fn next_scan(&mut self) {
         self.scan_id = self.scan_id.wrapping_add(1);
