@@ -6,7 +6,8 @@
 //!   true pose 2.5 m and 0.3 rad from the guess;
 //! * `bnb/window_0.5m_3deg` and `exhaustive/window_0.5m_3deg` — the same query over a window
 //!   small enough to score every candidate (Hess Algorithm 1), for the speed-up;
-//! * `precompute/depth_7` — building the precomputed grids of the submap (once per submap);
+//! * `precompute/depth_7` — building the precomputed grids of the submap (once per submap),
+//!   and `depth_7_plain`, the sliding-window version it replaced;
 //! * `pose_graph/manhattan_1000` and `pose_graph/manhattan_3500` — sparse pose adjustment
 //!   (Konolige et al. 2010) of Manhattan-world graphs (1000 nodes / ~1500 edges, and the size of
 //!   Olson's M3500: 3500 / ~5450), from dead reckoning to convergence.
@@ -111,6 +112,9 @@ fn bench_bnb(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1));
     g.bench_function("depth_7", |b| {
         b.iter(|| PrecomputedGrids::new(black_box(&submap), 7))
+    });
+    g.bench_function("depth_7_plain", |b| {
+        b.iter(|| PrecomputedGrids::new_plain(black_box(&submap), 7))
     });
     g.finish();
 }

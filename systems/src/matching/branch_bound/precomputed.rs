@@ -8,8 +8,11 @@
 //! probability grids: scores become integer sums, so the branch-and-bound and the exhaustive
 //! search compare exactly the same numbers, and the grids take a quarter of the memory.
 //!
-//! Each level is built in O(n) — independent of the window 2^h — by a 1-D sliding-window maximum
-//! (monotone deque) along the rows, then along the columns of that result.
+//! Each level is built in O(n) from the one below it: a window of 2^h is two windows of 2^(h−1)
+//! side by side, so level h is the maximum of level h − 1 and level h − 1 shifted by 2^(h−1),
+//! first along the rows, then along the columns (the doubling of van Herk / Gil–Werman's
+//! separable max filter). The plain version, kept for the tests and the benchmark, slides a 1-D
+//! window maximum (monotone deque) along the rows and columns of the map for every level.
 
 use crate::matching::ProbGrid;
 
@@ -83,10 +86,66 @@ fn sliding_max(input: &[u8], win: usize, out: &mut [u8], deque: &mut Vec<usize>)
     }
 }
 
+/// Level `h` from level `below` (h − 1) of a `w` × `h` map: shift s = 2^(h−1). A stored index
+/// of level h is the stored index of level h − 1 plus s (its pad is s larger), so a cell's two
+/// half-windows are at indices x − s and x of the level below, 0 where that is off its stored
+/// area.
+fn double(below: &Level, s: usize) -> Level {
+    let (stride, rows) = (below.stride + s, below.rows + s);
+    // along the rows: below.rows rows of stride
+    let mut horiz = vec![0u8; stride * below.rows];
+    for (src, dst) in below
+        .data
+        .chunks_exact(below.stride)
+        .zip(horiz.chunks_exact_mut(stride))
+    {
+        // dst[x] = max(src[x − s], src[x]) where they exist
+        dst[..below.stride].copy_from_slice(src);
+        for (d, &v) in dst[s..].iter_mut().zip(src) {
+            *d = (*d).max(v);
+        }
+    }
+    // along the columns: row y = max(horiz row y − s, horiz row y)
+    let mut data = vec![0u8; stride * rows];
+    data[..horiz.len()].copy_from_slice(&horiz);
+    for (d, &v) in data[s * stride..].iter_mut().zip(&horiz) {
+        *d = (*d).max(v);
+    }
+    Level {
+        pad: below.pad + s as i32,
+        stride,
+        rows,
+        data,
+    }
+}
+
 impl PrecomputedGrids {
     /// Levels 0..`depth` (at least one). Hess et al. use depth 7 at 5 cm (a top node covers
     /// 64 × 64 cells, 3.2 m).
     pub fn new(grid: &ProbGrid, depth: usize) -> Self {
+        let depth = depth.max(1);
+        let base = Level {
+            pad: 0,
+            stride: grid.width,
+            rows: grid.height,
+            data: grid.p.iter().map(|&p| quantize(p)).collect(),
+        };
+        let mut levels = Vec::with_capacity(depth);
+        levels.push(base);
+        for level in 1..depth {
+            let next = double(&levels[level - 1], 1 << (level - 1));
+            levels.push(next);
+        }
+        PrecomputedGrids {
+            levels,
+            resolution: grid.resolution,
+            origin: grid.origin,
+        }
+    }
+
+    /// [`PrecomputedGrids::new`] by a sliding window maximum over the map for every level: the
+    /// plain version the tests and the `loop_closure` benchmark compare it with.
+    pub fn new_plain(grid: &ProbGrid, depth: usize) -> Self {
         let depth = depth.max(1);
         let (w, h) = (grid.width, grid.height);
         let base: Vec<u8> = grid.p.iter().map(|&p| quantize(p)).collect();
@@ -165,6 +224,31 @@ mod tests {
                 let hi = i.min(input.len() - 1);
                 let m = input[lo..=hi].iter().copied().max().unwrap_or(0);
                 assert_eq!(o, m, "win {win} i {i}");
+            }
+        }
+    }
+
+    /// The doubling builds every level exactly as the sliding window over the map does, on
+    /// odd sizes, a one-cell map and deep levels wider than the map.
+    #[test]
+    fn doubling_equals_the_sliding_window() {
+        for (w, h, depth) in [(11, 7, 4), (1, 1, 3), (37, 5, 7), (64, 65, 6)] {
+            let mut g = ProbGrid::new(w, h, 0.1, [0.0, 0.0], 0.0);
+            for (k, p) in g.p.iter_mut().enumerate() {
+                *p = ((k * 7919 % 1009) as f32) / 1008.0;
+            }
+            let (fast, plain) = (
+                PrecomputedGrids::new(&g, depth),
+                PrecomputedGrids::new_plain(&g, depth),
+            );
+            assert_eq!(fast.depth(), plain.depth());
+            for (a, b) in fast.levels.iter().zip(&plain.levels) {
+                assert_eq!(
+                    (a.pad, a.stride, a.rows),
+                    (b.pad, b.stride, b.rows),
+                    "{w} x {h}"
+                );
+                assert!(a.data == b.data, "{w} x {h}, level pad {}", a.pad);
             }
         }
     }
