@@ -5,6 +5,7 @@
 //! initialisation and random particles). Edits go through [`LocalizationMap::set_cells`] so all
 //! views stay consistent.
 
+use crate::core::cache::MapCache;
 use crate::raycast::RayMap;
 use crate::world::{Cell, DistanceField, OccupancyGrid};
 use bevy_ecs::prelude::Resource;
@@ -29,7 +30,18 @@ impl LocalizationMap {
     /// [`LocalizationMap::new`] with the ray-casting map of `grid` already built (the static
     /// world's, before any edit: the same map, so it need not be built twice).
     pub fn with_rays(grid: OccupancyGrid, max_dist: f64, rays: RayMap) -> Self {
-        let field = DistanceField::new(&grid, max_dist);
+        Self::with_rays_cached(grid, max_dist, rays, &MapCache::disabled())
+    }
+
+    /// [`LocalizationMap::with_rays`] with the distance field read from `cache` when it holds
+    /// it.
+    pub fn with_rays_cached(
+        grid: OccupancyGrid,
+        max_dist: f64,
+        rays: RayMap,
+        cache: &MapCache,
+    ) -> Self {
+        let field = DistanceField::new_cached(&grid, max_dist, cache);
         let free = Self::free_cells(&grid);
         LocalizationMap {
             grid,
@@ -64,11 +76,21 @@ impl LocalizationMap {
         let (c, r) = if self.free.is_empty() {
             (u() * g.width as f64, u() * g.height as f64)
         } else {
-            let k = ((u() * self.free.len() as f64) as usize).min(self.free.len() - 1);
-            let i = self.free[k] as usize;
+            let i = self.free[self.free_slot(u())] as usize;
             ((i % g.width) as f64 + u(), (i / g.width) as f64 + u())
         };
-        let th = (u() * 2.0 - 1.0) * std::f64::consts::PI;
+        self.pose_at(c, r, u())
+    }
+
+    /// The index into the free cells a uniform draw picks (some free cell exists).
+    fn free_slot(&self, u: f64) -> usize {
+        ((u * self.free.len() as f64) as usize).min(self.free.len() - 1)
+    }
+
+    /// The pose at fractional cell (c, r), heading from a uniform draw.
+    fn pose_at(&self, c: f64, r: f64, u: f64) -> (f64, f64, f64) {
+        let g = &self.grid;
+        let th = (u * 2.0 - 1.0) * std::f64::consts::PI;
         (
             g.origin[0] + c * g.resolution,
             g.origin[1] + r * g.resolution,
