@@ -15,7 +15,6 @@
 //! one that is truncated, corrupt or not for its key is rebuilt and replaced. The cache never
 //! fails a build: a folder that cannot be read or written only costs the time of building.
 
-use crate::world::OccupancyGrid;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -85,25 +84,6 @@ impl CacheKey {
 
     pub fn str(self, s: &str) -> Self {
         self.bytes(s.as_bytes())
-    }
-
-    /// Every field of an occupancy grid: size, resolution, origin and cells.
-    pub fn grid(mut self, g: &OccupancyGrid) -> Self {
-        self = self
-            .u64(g.width as u64)
-            .u64(g.height as u64)
-            .f64(g.resolution)
-            .f64(g.origin[0])
-            .f64(g.origin[1])
-            .u64(g.cells.len() as u64);
-        let mut buf = [0u8; 4096];
-        for chunk in g.cells.chunks(buf.len()) {
-            for (b, &c) in buf.iter_mut().zip(chunk) {
-                *b = c as u8;
-            }
-            self.hasher.update(&buf[..chunk.len()]);
-        }
-        self
     }
 
     /// The hash of everything fed in.

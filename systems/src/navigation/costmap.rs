@@ -124,8 +124,8 @@ impl Costmap {
         params: &CostmapParams,
         cache: &MapCache,
     ) -> Self {
-        let key = CacheKey::new::<Costmap>()
-            .grid(grid)
+        let key = grid
+            .add_to_key(CacheKey::new::<Costmap>())
             .f64(params.robot_radius)
             .f64(params.inflation_radius)
             .f64(params.cost_scaling_factor)

@@ -58,7 +58,7 @@ impl RayMap {
 
     /// [`RayMap::from_grid`] through `cache`.
     pub fn from_grid_cached(grid: &crate::world::OccupancyGrid, cache: &MapCache) -> Self {
-        let key = CacheKey::new::<RayMap>().grid(grid);
+        let key = grid.add_to_key(CacheKey::new::<RayMap>());
         cache.get_or_build(&key, || RayMap::from_grid(grid))
     }
 

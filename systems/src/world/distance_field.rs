@@ -260,7 +260,9 @@ impl DistanceField {
 
     /// [`DistanceField::new`] through `cache`.
     pub fn new_cached(grid: &OccupancyGrid, max_dist: f64, cache: &MapCache) -> Self {
-        let key = CacheKey::new::<DistanceField>().grid(grid).f64(max_dist);
+        let key = grid
+            .add_to_key(CacheKey::new::<DistanceField>())
+            .f64(max_dist);
         cache.get_or_build(&key, || DistanceField::new(grid, max_dist))
     }
 

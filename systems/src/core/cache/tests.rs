@@ -2,7 +2,7 @@ use super::*;
 use crate::navigation::{Costmap, CostmapParams};
 use crate::raycast::RayMap;
 use crate::world::roads::SurfaceRaster;
-use crate::world::{Cell, DistanceField};
+use crate::world::{Cell, DistanceField, OccupancyGrid};
 
 /// A structure that counts nothing but its own bytes.
 #[derive(Debug, Clone, PartialEq)]
