@@ -2,7 +2,7 @@
 //! `sim` commands, and `sim cache info` / `sim cache clear`.
 //!
 //! The commands use the cache unless `--no-cache` or `SIM_NO_CACHE=1` turns it off; its folder
-//! is `$SIM_CACHE_DIR`, else the platform's cache folder (`~/.cache/sim` on Linux). A program
+//! is `$SIM_CACHE_DIR`, else the platform's cache folder (`~/.cache/sim/maps` on Linux). A program
 //! using the library builds without a cache unless it asks for one
 //! ([`crate::SimulationBuilder::cache`]).
 
@@ -25,12 +25,13 @@ pub fn process_cache() -> MapCache {
     PROCESS.get().cloned().unwrap_or_default()
 }
 
-/// The cache folder: `$SIM_CACHE_DIR` if set and not empty, else `sim` in the platform's cache
-/// folder; none if neither is known.
+/// The cache folder: `$SIM_CACHE_DIR` if set and not empty, else `sim/maps` in the platform's
+/// cache folder (`sim` itself also holds the test tools of `tests/run.sh`); none if neither is
+/// known.
 pub fn default_dir() -> Option<PathBuf> {
     match std::env::var_os("SIM_CACHE_DIR") {
         Some(d) if !d.is_empty() => Some(PathBuf::from(d)),
-        _ => directories::BaseDirs::new().map(|b| b.cache_dir().join("sim")),
+        _ => directories::BaseDirs::new().map(|b| b.cache_dir().join("sim").join("maps")),
     }
 }
 
