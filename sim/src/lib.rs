@@ -27,6 +27,7 @@
 pub mod batch;
 pub mod bench;
 pub mod build;
+pub mod cache;
 pub mod cli;
 pub mod experiment;
 pub mod formats;

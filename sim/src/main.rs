@@ -8,6 +8,7 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     restore_sigpipe();
     let cli = Cli::parse();
+    sim::cache::set_process_cache(sim::cache::from_env(cli.no_cache));
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) if e.is::<Interrupted>() => {

@@ -1,12 +1,15 @@
 //! `sim bench startup`: how long `sim run` takes before its first tick, part by part (reading
 //! and resolving the scenario, then each phase of building the world, [`BuildTimes`]), and the
 //! first tick beside the ticks after it (global localizers do their widest work in the first
-//! update). Every run builds its world from nothing in this process; the first run of each
-//! scenario is reported apart from the median of the others, since it also reads the files and
-//! fills the allocator's pages.
+//! update). Every run builds its world from nothing in this process, cold (an empty cache of
+//! map-derived structures, a new folder per run: everything is built, then written) and warm (the
+//! cache filled: the map-derived structures are read). The first run of each series is reported
+//! apart from the median of the others, since it also reads the files and fills the allocator's
+//! pages.
 
 use crate::Simulation;
 use crate::build::BuildTimes;
+use crate::cache::MapCache;
 use crate::scenario::{bundled_scenarios, scenario_path};
 use crate::stats::median;
 use serde::Serialize;
@@ -31,11 +34,24 @@ pub struct StartupOptions {
     pub json: bool,
 }
 
-/// One scenario's start-up (ms).
+/// One scenario's start-up (ms), cold and warm.
 #[derive(Serialize, Debug, Clone)]
 pub struct StartupRow {
     pub scenario: String,
     pub runs: u32,
+    /// Every run with an empty cache (a new folder each).
+    pub cold: StartupSeries,
+    /// Every run with the cache filled.
+    pub warm: StartupSeries,
+    /// The first tick (median over both series).
+    pub first_tick_ms: f64,
+    /// Median of the ticks after the first.
+    pub tick_ms: f64,
+}
+
+/// The start-up of one series of runs (ms).
+#[derive(Serialize, Debug, Clone)]
+pub struct StartupSeries {
     /// Reading, parsing and resolving the scenario (maps, places, defaults).
     pub load_ms: f64,
     /// Building the world, phase by phase (in build order), and the outputs and schedule.
@@ -43,11 +59,8 @@ pub struct StartupRow {
     pub phases_ms: Vec<(String, f64)>,
     /// `load_ms + build_ms`: the time before the first tick.
     pub before_first_tick_ms: f64,
-    /// The same for the first run in the process.
+    /// The same for the series' first run.
     pub first_run_before_first_tick_ms: f64,
-    pub first_tick_ms: f64,
-    /// Median of the ticks after the first.
-    pub tick_ms: f64,
 }
 
 struct Sample {
@@ -62,13 +75,19 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-fn sample(path: &std::path::Path, threads: usize, ticks: u32) -> anyhow::Result<Sample> {
+fn sample(
+    path: &std::path::Path,
+    threads: usize,
+    ticks: u32,
+    cache: MapCache,
+) -> anyhow::Result<Sample> {
     let started = Instant::now();
     let scenario = crate::scenario::load_scenario(path)?;
     let load = ms(started.elapsed());
     let started = Instant::now();
     let mut sim = Simulation::from_scenario(scenario)
         .threads(threads)
+        .cache(cache)
         .build()?;
     let build = ms(started.elapsed());
     let phases = sim
@@ -97,38 +116,55 @@ fn sample(path: &std::path::Path, threads: usize, ticks: u32) -> anyhow::Result<
     })
 }
 
-/// Start-up of the scenario at `path`, `runs` times.
+/// The medians of a series (its first run apart).
+fn series(samples: &[Sample]) -> StartupSeries {
+    let (first, rest) = samples.split_first().expect("at least two runs");
+    let med = |f: &dyn Fn(&Sample) -> f64| median(&mut rest.iter().map(f).collect::<Vec<_>>());
+    StartupSeries {
+        load_ms: med(&|s| s.load),
+        build_ms: med(&|s| s.build),
+        phases_ms: first
+            .phases
+            .iter()
+            .enumerate()
+            .map(|(i, &(name, _))| (name.to_string(), med(&|s| s.phases[i].1)))
+            .collect(),
+        before_first_tick_ms: med(&|s| s.load + s.build),
+        first_run_before_first_tick_ms: first.load + first.build,
+    }
+}
+
+/// Start-up of the scenario at `path`, `runs` times cold and `runs` times warm, with cache
+/// folders under a temporary folder (removed at the end).
 pub fn measure(
     name: &str,
     path: &std::path::Path,
     o: &StartupOptions,
 ) -> anyhow::Result<StartupRow> {
-    let samples = (0..o.runs)
-        .map(|_| sample(path, o.threads, o.ticks))
+    let tmp = tempfile::tempdir()?;
+    let cold = (0..o.runs)
+        .map(|k| {
+            let cache = MapCache::in_dir(tmp.path().join(format!("cold-{k}")));
+            sample(path, o.threads, o.ticks, cache)
+        })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let (first, rest) = samples.split_first().expect("at least two runs");
-    let med = |f: &dyn Fn(&Sample) -> f64| median(&mut rest.iter().map(f).collect::<Vec<_>>());
-    let load_ms = med(&|s| s.load);
-    let build_ms = med(&|s| s.build);
-    let phases_ms = first
-        .phases
-        .iter()
-        .enumerate()
-        .map(|(i, &(name, _))| (name.to_string(), med(&|s| s.phases[i].1)))
-        .collect();
+    // the last cold run's folder holds every entry
+    let filled = tmp.path().join(format!("cold-{}", o.runs - 1));
+    let warm = (0..o.runs)
+        .map(|_| sample(path, o.threads, o.ticks, MapCache::in_dir(&filled)))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let after_first = || cold[1..].iter().chain(&warm[1..]);
     Ok(StartupRow {
         scenario: name.to_string(),
         runs: o.runs,
-        load_ms,
-        build_ms,
-        phases_ms,
-        before_first_tick_ms: med(&|s| s.load + s.build),
-        first_run_before_first_tick_ms: first.load + first.build,
-        first_tick_ms: med(&|s| s.first_tick),
-        tick_ms: med(&|s| {
-            let mut t = s.ticks.clone();
-            median(&mut t)
-        }),
+        cold: series(&cold),
+        warm: series(&warm),
+        first_tick_ms: median(&mut after_first().map(|s| s.first_tick).collect::<Vec<_>>()),
+        tick_ms: median(
+            &mut after_first()
+                .map(|s| median(&mut s.ticks.clone()))
+                .collect::<Vec<_>>(),
+        ),
     })
 }
 
@@ -144,7 +180,8 @@ pub fn run_startup_bench(o: &StartupOptions) -> anyhow::Result<()> {
     };
     if !o.json {
         println!(
-            "start-up before the first tick, medians of {} runs after the first; {}",
+            "start-up before the first tick, cold (empty cache) and warm (cache filled), medians \
+             of {} runs after the first; {}",
             o.runs - 1,
             crate::bench::machine::describe()
         );
@@ -162,22 +199,29 @@ pub fn run_startup_bench(o: &StartupOptions) -> anyhow::Result<()> {
 
 fn format_row(r: &StartupRow) -> String {
     let mut out = format!(
-        "{}: {:.1} ms before the first tick (first run {:.1} ms); first tick {:.1} ms, then {:.3} ms per tick\n  load {:.1} ms\n",
+        "{}: cold {:.1} ms, warm {:.1} ms before the first tick (first runs {:.1} and {:.1} ms); \
+         first tick {:.1} ms, then {:.3} ms per tick\n  {:<30}{:>9}{:>9}\n",
         r.scenario,
-        r.before_first_tick_ms,
-        r.first_run_before_first_tick_ms,
+        r.cold.before_first_tick_ms,
+        r.warm.before_first_tick_ms,
+        r.cold.first_run_before_first_tick_ms,
+        r.warm.first_run_before_first_tick_ms,
         r.first_tick_ms,
         r.tick_ms,
-        r.load_ms
+        "(ms)",
+        "cold",
+        "warm",
     );
-    let phases: f64 = r.phases_ms.iter().map(|p| p.1).sum();
-    for (name, t) in &r.phases_ms {
-        out.push_str(&format!("  {name} {t:.1} ms\n"));
+    let mut line = |name: &str, cold: f64, warm: f64| {
+        out.push_str(&format!("  {name:<30}{cold:>9.1}{warm:>9.1}\n"));
+    };
+    line("load", r.cold.load_ms, r.warm.load_ms);
+    for ((name, cold), (_, warm)) in r.cold.phases_ms.iter().zip(&r.warm.phases_ms) {
+        line(name, *cold, *warm);
     }
-    out.push_str(&format!(
-        "  outputs and schedule {:.1} ms\n",
-        (r.build_ms - phases).max(0.0)
-    ));
+    let rest =
+        |s: &StartupSeries| (s.build_ms - s.phases_ms.iter().map(|p| p.1).sum::<f64>()).max(0.0);
+    line("outputs and schedule", rest(&r.cold), rest(&r.warm));
     out
 }
 
@@ -198,19 +242,23 @@ mod tests {
         };
         let path = scenario_path(Some("maze_run")).unwrap();
         let row = measure("maze_run", &path, &o).unwrap();
-        let names: Vec<&str> = row.phases_ms.iter().map(|p| p.0.as_str()).collect();
-        assert_eq!(names.first(), Some(&"kernel pool"));
-        assert_eq!(names.last(), Some(&"plugins"));
-        assert!(names.contains(&"localization map"), "{names:?}");
-        let sum: f64 = row.phases_ms.iter().map(|p| p.1).sum();
-        assert!(
-            sum <= row.build_ms * 1.001 + 1e-3,
-            "{sum} > {}",
-            row.build_ms
-        );
-        assert!(row.before_first_tick_ms >= row.build_ms);
+        for series in [&row.cold, &row.warm] {
+            let names: Vec<&str> = series.phases_ms.iter().map(|p| p.0.as_str()).collect();
+            assert_eq!(names.first(), Some(&"kernel pool"));
+            assert_eq!(names.last(), Some(&"plugins"));
+            assert!(names.contains(&"localization map"), "{names:?}");
+            let sum: f64 = series.phases_ms.iter().map(|p| p.1).sum();
+            assert!(
+                sum <= series.build_ms * 1.001 + 1e-3,
+                "{sum} > {}",
+                series.build_ms
+            );
+            assert!(series.before_first_tick_ms >= series.build_ms);
+        }
+        assert_eq!(row.cold.phases_ms.len(), row.warm.phases_ms.len());
         assert!(row.first_tick_ms > 0.0 && row.tick_ms > 0.0);
         let text = format_row(&row);
         assert!(text.contains("outputs and schedule"), "{text}");
+        assert!(text.contains("cold") && text.contains("warm"), "{text}");
     }
 }

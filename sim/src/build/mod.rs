@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use systems::body::{
     Kinematics, PeoplePlugin, PersonId, PersonIndex, Physics, PhysicsPlugin, TruePose, Walker,
 };
-use systems::core::{KernelPool, SimClock, SimPlugin, SimRng, new_schedule, stream_rng};
+use systems::core::{KernelPool, MapCache, SimClock, SimPlugin, SimRng, new_schedule, stream_rng};
 use systems::eval::{EvalPlugin, LocalizationSamples, NavOutcome};
 use systems::localization::de_filter::DeFilter;
 use systems::localization::de_mc::DeMc;
@@ -146,18 +146,28 @@ impl BuildTimes {
     }
 }
 
-/// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores).
+/// Builds the world for `scenario` with a kernel pool of `threads` workers (0 = all cores), with
+/// the process's cache of map-derived structures ([`crate::cache::process_cache`]).
 pub fn build_world(scenario: &Scenario, threads: usize) -> anyhow::Result<SimWorld> {
-    build_world_with(scenario, threads, BuildMode::Live, Reusable::default())
+    build_world_with(
+        scenario,
+        threads,
+        BuildMode::Live,
+        Reusable::default(),
+        &crate::cache::process_cache(),
+    )
 }
 
 /// [`build_world`] for a live run or a replay, with what an earlier world of the same scenario
-/// left ([`Reusable::take`]; `Reusable::default()` for none).
+/// left ([`Reusable::take`]; `Reusable::default()` for none), reading and writing the structures
+/// that depend on the map alone (ray caster, costmaps, likelihood field, road raster) through
+/// `cache`.
 pub fn build_world_with(
     scenario: &Scenario,
     threads: usize,
     mode: BuildMode,
     reuse: Reusable,
+    cache: &MapCache,
 ) -> anyhow::Result<SimWorld> {
     let live = mode == BuildMode::Live;
     let mut times = BuildTimes::start();
@@ -167,7 +177,7 @@ pub fn build_world_with(
     world.insert_resource(pool);
     world.insert_resource(SimClock::new(scenario.dt));
     times.lap("kernel pool");
-    let mut static_world = StaticWorld::new(scenario.grid.clone());
+    let mut static_world = StaticWorld::new_cached(scenario.grid.clone(), cache);
     times.lap("ray caster");
     let mut physics = Physics::new(&mut static_world, scenario.dt);
     times.lap("wall colliders");
@@ -181,7 +191,7 @@ pub fn build_world_with(
     let costmaps = (!nav_params.is_empty()).then(|| {
         reuse
             .costmaps
-            .unwrap_or_else(|| NavCostmaps::new(&static_world, &nav_params))
+            .unwrap_or_else(|| NavCostmaps::new_cached(&static_world, &nav_params, cache))
     });
     times.lap("navigation costmaps");
     // the map the localizers believe in is the floor plan as it is at the start: the static
@@ -207,7 +217,9 @@ pub fn build_world_with(
         let max_dist = field_max_dist.unwrap_or(scenario.grid.resolution);
         let map = match (reuse.localization_map, localizer_rays) {
             (Some(map), _) => map,
-            (None, Some(rays)) => LocalizationMap::with_rays(scenario.grid.clone(), max_dist, rays),
+            (None, Some(rays)) => {
+                LocalizationMap::with_rays_cached(scenario.grid.clone(), max_dist, rays, cache)
+            }
             (None, None) => LocalizationMap::new(scenario.grid.clone(), max_dist),
         };
         world.insert_resource(map);
@@ -215,7 +227,7 @@ pub fn build_world_with(
 
     times.lap("localization map");
     if live {
-        crate::build::outdoor::insert_outdoor_world(&mut world, scenario);
+        crate::build::outdoor::insert_outdoor_world(&mut world, scenario, cache);
     }
     times.lap("outdoor world");
     let mut robots = Vec::with_capacity(scenario.robots.len());

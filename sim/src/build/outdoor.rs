@@ -8,7 +8,7 @@ use crate::scenario::{RobotConfig, Scenario};
 use bevy_ecs::prelude::*;
 use std::sync::Arc;
 use systems::body::Kinematics;
-use systems::core::stream_rng;
+use systems::core::{MapCache, stream_rng};
 use systems::eval::road_metrics::RoadRunMetrics;
 use systems::localization::road_wiring::{RoadLocalization, RoadLocalizerSlot};
 use systems::localization::{RoadGrid, RoadLocalizer, RoadMcl};
@@ -22,13 +22,14 @@ use systems::world::roads::{GeoFrame, RoadMap, RoadSurface, SurfaceRaster};
 /// Cell size of the road surface the cameras render (m).
 const SURFACE_RESOLUTION: f64 = 0.05;
 
-/// Road network, geographic frame, road surface (when a robot has a camera) and zones.
-pub fn insert_outdoor_world(world: &mut World, scenario: &Scenario) {
+/// Road network, geographic frame, road surface (when a robot has a camera, through `cache`)
+/// and zones.
+pub fn insert_outdoor_world(world: &mut World, scenario: &Scenario, cache: &MapCache) {
     if let Some(r) = &scenario.roads {
         world.insert_resource(RoadMap(r.graph.clone()));
         world.insert_resource(GeoFrame(r.graph.projection));
         if scenario.robots.iter().any(|r| r.camera.is_some()) {
-            let raster = SurfaceRaster::build(&r.graph, SURFACE_RESOLUTION, r.margin);
+            let raster = SurfaceRaster::build_cached(&r.graph, SURFACE_RESOLUTION, r.margin, cache);
             world.insert_resource(RoadSurface(Arc::new(raster)));
         }
     }

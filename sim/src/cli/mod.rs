@@ -20,6 +20,10 @@ use clap::{Parser, Subcommand};
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Build every map-derived structure instead of reading it from the on-disk cache (also
+    /// `SIM_NO_CACHE=1`); nothing is written to the cache either.
+    #[arg(long, global = true)]
+    pub no_cache: bool,
 }
 
 #[derive(Subcommand)]
@@ -53,6 +57,12 @@ pub enum Command {
     Experiment {
         #[command(subcommand)]
         which: experiment::ExperimentCommand,
+    },
+    /// The on-disk cache of map-derived structures (distance fields, costmaps, road raster):
+    /// where it is and what it holds, or clear it.
+    Cache {
+        #[command(subcommand)]
+        which: crate::cache::CacheCommand,
     },
     /// Benchmarks.
     Bench {
@@ -91,6 +101,7 @@ pub fn dispatch(cmd: Command) -> anyhow::Result<()> {
         Command::Scans(a) => scans::scans_command(a),
         Command::Match(o) => crate::experiment::match_pair::run_match(&o),
         Command::Experiment { which } => experiment::experiment_command(which),
+        Command::Cache { which } => crate::cache::cache_command(&which),
         Command::Bench { which } => bench::bench_command(which),
     }
 }

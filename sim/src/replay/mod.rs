@@ -62,7 +62,13 @@ pub fn build_replay(plan: ReplayPlan, threads: usize) -> anyhow::Result<(SimWorl
     let ReplayPlan {
         scenario, feeds, ..
     } = plan;
-    let mut sim = build_world_with(&scenario, threads, BuildMode::Replay, Reusable::default())?;
+    let mut sim = build_world_with(
+        &scenario,
+        threads,
+        BuildMode::Replay,
+        Reusable::default(),
+        &crate::cache::process_cache(),
+    )?;
     let mut robots = Vec::with_capacity(feeds.len());
     for (&entity, feed) in sim.robots.iter().zip(feeds) {
         if !feed.odometry.is_empty() {

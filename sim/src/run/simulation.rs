@@ -22,7 +22,8 @@ use super::exports::{Exported, RunExports};
 use super::outputs;
 use super::summary::{Summary, collect};
 use super::view::{DoorView, PersonView, RobotView};
-use crate::build::{BuildMode, Reusable, SimWorld, build_world, build_world_with};
+use crate::build::{BuildMode, Reusable, SimWorld, build_world_with};
+use crate::cache::MapCache;
 use crate::formats::tum::RobotLocalization;
 use crate::options::check_duration;
 use crate::scenario::overrides::Override;
@@ -45,6 +46,8 @@ pub struct Simulation {
     /// Whether a recording or export is being written (a restart would overwrite it).
     writes_files: bool,
     threads: usize,
+    /// The cache of map-derived structures the world was built with, for a restart.
+    cache: MapCache,
     /// The user's estimators as given (before any scan), for a restart.
     estimators: Vec<(String, String, Filter)>,
     /// Ticks run so far.
@@ -87,6 +90,8 @@ pub struct SimulationBuilder {
     seed: Option<u64>,
     duration: Option<f64>,
     threads: usize,
+    /// `None`: the process's ([`crate::cache::process_cache`]).
+    cache: Option<MapCache>,
     rrd: Option<PathBuf>,
     exports: RunExports,
     /// User controllers by robot name.
@@ -103,6 +108,7 @@ impl SimulationBuilder {
             seed: None,
             duration: None,
             threads: 0,
+            cache: None,
             rrd: None,
             exports: RunExports::default(),
             controllers: Vec::new(),
@@ -142,6 +148,16 @@ impl SimulationBuilder {
     /// depend on it.
     pub fn threads(mut self, threads: usize) -> Self {
         self.threads = threads;
+        self
+    }
+
+    /// Reads and writes the structures that depend on the map alone (ray caster, costmaps,
+    /// likelihood field, road raster) through `cache` ([`MapCache::in_dir`], or
+    /// [`crate::cache::from_env`] for the commands' folder); results are the same with any
+    /// cache or none. Default: the process's ([`crate::cache::process_cache`]), which is none
+    /// unless the command line set it.
+    pub fn cache(mut self, cache: MapCache) -> Self {
+        self.cache = Some(cache);
         self
     }
 
@@ -254,11 +270,19 @@ impl SimulationBuilder {
     /// Builds the world, opens the outputs' files and adds their recorders to the schedule.
     pub fn build(self) -> anyhow::Result<Simulation> {
         let scenario = self.scenario()?;
-        let mut world = build_world(&scenario, self.threads)?;
+        let cache = self.cache.unwrap_or_else(crate::cache::process_cache);
+        let mut world = build_world_with(
+            &scenario,
+            self.threads,
+            BuildMode::Live,
+            Reusable::default(),
+            &cache,
+        )?;
         attach_estimators(&mut world, &scenario, self.estimators.clone())?;
         attach_controllers(&mut world, &scenario, self.controllers)?;
         let mut sim = Simulation::from_world(world, scenario, self.rrd.as_deref(), &self.exports)?;
         sim.threads = self.threads;
+        sim.cache = cache;
         sim.estimators = self.estimators;
         Ok(sim)
     }
@@ -301,6 +325,7 @@ impl Simulation {
             writes_files: rrd.is_some() || exports.writes_files(),
             exports: exports.clone(),
             threads: 0,
+            cache: MapCache::disabled(),
             estimators: Vec::new(),
             ticks: 0,
             started: None,
@@ -334,7 +359,8 @@ impl Simulation {
             .unwrap_or_default();
         let mut scenario = self.scenario.clone();
         scenario.seed = seed;
-        let mut world = build_world_with(&scenario, self.threads, BuildMode::Live, reuse)?;
+        let mut world =
+            build_world_with(&scenario, self.threads, BuildMode::Live, reuse, &self.cache)?;
         attach_estimators(&mut world, &scenario, self.estimators.clone())?;
         attach_controllers(&mut world, &scenario, controllers)?;
         outputs::install(&mut world, &scenario, None, &RunExports::default())?;

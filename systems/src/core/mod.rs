@@ -1,7 +1,8 @@
 //! Components and resources every system shares: poses, the simulation clock, per-entity random
 //! streams, robot identity, the tick schedule and the kernel thread pool (and where the source
-//! tree is, for its assets).
+//! tree is, for its assets); the on-disk cache of map-derived structures.
 
+pub mod cache;
 pub mod clock;
 pub mod cpu;
 pub mod ids;
@@ -16,6 +17,7 @@ pub mod source;
 pub mod spatial_order;
 pub mod test_tools;
 
+pub use cache::{CacheKey, Cached, MapCache};
 pub use clock::SimClock;
 pub use ids::{RobotId, RobotIndex};
 pub use jobs::JobMemory;

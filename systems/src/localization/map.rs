@@ -5,6 +5,7 @@
 //! initialisation and random particles). Edits go through [`LocalizationMap::set_cells`] so all
 //! views stay consistent.
 
+use crate::core::cache::MapCache;
 use crate::raycast::RayMap;
 use crate::world::{Cell, DistanceField, OccupancyGrid};
 use bevy_ecs::prelude::Resource;
@@ -29,7 +30,18 @@ impl LocalizationMap {
     /// [`LocalizationMap::new`] with the ray-casting map of `grid` already built (the static
     /// world's, before any edit: the same map, so it need not be built twice).
     pub fn with_rays(grid: OccupancyGrid, max_dist: f64, rays: RayMap) -> Self {
-        let field = DistanceField::new(&grid, max_dist);
+        Self::with_rays_cached(grid, max_dist, rays, &MapCache::disabled())
+    }
+
+    /// [`LocalizationMap::with_rays`] with the distance field read from `cache` when it holds
+    /// it.
+    pub fn with_rays_cached(
+        grid: OccupancyGrid,
+        max_dist: f64,
+        rays: RayMap,
+        cache: &MapCache,
+    ) -> Self {
+        let field = DistanceField::new_cached(&grid, max_dist, cache);
         let free = Self::free_cells(&grid);
         LocalizationMap {
             grid,
@@ -64,11 +76,50 @@ impl LocalizationMap {
         let (c, r) = if self.free.is_empty() {
             (u() * g.width as f64, u() * g.height as f64)
         } else {
-            let k = ((u() * self.free.len() as f64) as usize).min(self.free.len() - 1);
-            let i = self.free[k] as usize;
+            let i = self.free[self.free_slot(u())] as usize;
             ((i % g.width) as f64 + u(), (i / g.width) as f64 + u())
         };
-        let th = (u() * 2.0 - 1.0) * std::f64::consts::PI;
+        self.pose_at(c, r, u())
+    }
+
+    /// `n` poses of [`LocalizationMap::random_free_pose`] from the same draws in the same
+    /// order, drawn first and then placed: the free cells they pick are scattered over the
+    /// map, and with no draw between them their loads overlap.
+    pub fn random_free_poses(&self, n: usize, u: &mut dyn FnMut() -> f64) -> Vec<[f64; 3]> {
+        if self.free.is_empty() {
+            return (0..n)
+                .map(|_| {
+                    let (x, y, th) = self.random_free_pose(u);
+                    [x, y, th]
+                })
+                .collect();
+        }
+        let draws: Vec<[f64; 4]> = (0..n).map(|_| [u(), u(), u(), u()]).collect();
+        let cells: Vec<u32> = draws
+            .iter()
+            .map(|d| self.free[self.free_slot(d[0])])
+            .collect();
+        let w = self.grid.width;
+        draws
+            .iter()
+            .zip(cells)
+            .map(|(d, i)| {
+                let i = i as usize;
+                let (x, y, th) = self.pose_at((i % w) as f64 + d[1], (i / w) as f64 + d[2], d[3]);
+                [x, y, th]
+            })
+            .collect()
+    }
+
+    /// The index into the free cells a uniform draw picks (some free cell exists).
+    fn free_slot(&self, u: f64) -> usize {
+        ((u * self.free.len() as f64) as usize).min(self.free.len() - 1)
+    }
+
+    /// The pose at fractional cell (c, r), heading from a uniform draw.
+    fn pose_at(&self, c: f64, r: f64, u: f64) -> (f64, f64, f64) {
+        let g = &self.grid;
+        let th = (u * 2.0 - 1.0) * std::f64::consts::PI;
         (
             g.origin[0] + c * g.resolution,
             g.origin[1] + r * g.resolution,
@@ -100,6 +151,38 @@ impl LocalizationMap {
 mod tests {
     use super::*;
     use crate::raycast::StaticWorld;
+
+    /// Poses drawn together are the poses drawn one by one from the same stream, with or
+    /// without free cells.
+    #[test]
+    fn poses_drawn_together_are_those_drawn_one_by_one() {
+        let mut grid = OccupancyGrid::new(37, 23, 0.1, [-1.0, 2.0], Cell::Free);
+        grid.set(3, 4, Cell::Occupied);
+        let full = OccupancyGrid::new(5, 4, 0.2, [0.0, 0.0], Cell::Occupied);
+        for grid in [grid, full] {
+            let map = LocalizationMap::new(grid, 1.0);
+            let stream = |seed: u64| {
+                let mut x = seed;
+                move || {
+                    x = x
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    (x >> 11) as f64 / (1u64 << 53) as f64
+                }
+            };
+            let mut u = stream(9);
+            let one_by_one: Vec<[f64; 3]> = (0..500)
+                .map(|_| {
+                    let (x, y, th) = map.random_free_pose(&mut u);
+                    [x, y, th]
+                })
+                .collect();
+            let together = map.random_free_poses(500, &mut stream(9));
+            let bits =
+                |v: &[[f64; 3]]| -> Vec<u64> { v.iter().flatten().map(|x| x.to_bits()).collect() };
+            assert_eq!(bits(&one_by_one), bits(&together));
+        }
+    }
 
     /// The localizers' map built on the static world's ray caster casts every ray and scan as
     /// one built on its own.

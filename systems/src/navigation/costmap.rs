@@ -15,6 +15,7 @@
 //! (`squared_distances`), so inflation is isotropic rather than the chamfer approximation of
 //! a breadth-first wave. Cells outside the grid are not obstacles.
 
+use crate::core::cache::{CacheKey, Cached, Decoder, Encoder, Malformed, MapCache};
 use crate::world::distance_field::squared_distances;
 use crate::world::{Cell, OccupancyGrid};
 
@@ -117,6 +118,21 @@ impl Costmap {
         }
     }
 
+    /// [`Costmap::from_grid`] through `cache`.
+    pub fn from_grid_cached(
+        grid: &OccupancyGrid,
+        params: &CostmapParams,
+        cache: &MapCache,
+    ) -> Self {
+        let key = grid
+            .add_to_key(CacheKey::new::<Costmap>())
+            .f64(params.robot_radius)
+            .f64(params.inflation_radius)
+            .f64(params.cost_scaling_factor)
+            .u64(params.unknown_is_lethal.into());
+        cache.get_or_build(&key, || Costmap::from_grid(grid, params))
+    }
+
     pub fn index(&self, col: usize, row: usize) -> usize {
         row * self.width + col
     }
@@ -140,6 +156,35 @@ impl Costmap {
             self.origin[0] + (col as f64 + 0.5) * self.resolution,
             self.origin[1] + (row as f64 + 0.5) * self.resolution,
         ]
+    }
+}
+
+/// Every field.
+impl Cached for Costmap {
+    const KIND: &'static str = "costmap";
+    const FORMAT: u32 = 1;
+
+    fn encode(&self, out: &mut Encoder) {
+        out.usize(self.width);
+        out.usize(self.height);
+        out.f64(self.resolution);
+        out.f64(self.origin[0]);
+        out.f64(self.origin[1]);
+        out.bytes(&self.costs);
+    }
+
+    fn decode(input: &mut Decoder<'_>) -> Result<Self, Malformed> {
+        let m = Costmap {
+            width: input.usize()?,
+            height: input.usize()?,
+            resolution: input.f64()?,
+            origin: [input.f64()?, input.f64()?],
+            costs: input.bytes()?.to_vec(),
+        };
+        if Some(m.costs.len()) != m.width.checked_mul(m.height) {
+            return Err(Malformed("costmap: cell count"));
+        }
+        Ok(m)
     }
 }
 

@@ -5,6 +5,7 @@
 //! per run, so a whole rebuild is cheaper to get right than a windowed one.
 
 use super::costmap::{Costmap, CostmapParams};
+use crate::core::cache::MapCache;
 use crate::raycast::StaticWorld;
 use bevy_ecs::prelude::*;
 
@@ -21,10 +22,15 @@ impl NavCostmaps {
     /// Costmaps for each parameter set of `params` (deduplicated; look indices up with
     /// [`NavCostmaps::index_of`]).
     pub fn new(world: &StaticWorld, params: &[CostmapParams]) -> Self {
+        Self::new_cached(world, params, &MapCache::disabled())
+    }
+
+    /// [`NavCostmaps::new`] with each costmap read from `cache` when it holds it.
+    pub fn new_cached(world: &StaticWorld, params: &[CostmapParams], cache: &MapCache) -> Self {
         let mut maps: Vec<(CostmapParams, Costmap)> = Vec::new();
         for p in params {
             if !maps.iter().any(|(q, _)| q == p) {
-                maps.push((*p, Costmap::from_grid(world.grid(), p)));
+                maps.push((*p, Costmap::from_grid_cached(world.grid(), p, cache)));
             }
         }
         NavCostmaps {

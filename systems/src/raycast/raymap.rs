@@ -12,6 +12,7 @@
 
 use super::leap::{Bounds, InCells, Lane, Single};
 use super::sweep::{Faces, TILE as FACE_TILE};
+use crate::core::cache::{CacheKey, Cached, Decoder, Encoder, Malformed, MapCache};
 
 /// Distances are capped, so an edit only changes the field within this many cells.
 const CAP: u8 = 120;
@@ -19,6 +20,11 @@ const TILE_SHIFT: usize = 3;
 const TILE: usize = 1 << TILE_SHIFT;
 /// Bytes after the field's last cell, so a 4-byte gather at any cell stays inside it.
 const PAD: usize = 3;
+
+/// Whether streams of rays on a padded field of `len` bytes take the AVX2 kernel.
+fn use_avx2(len: usize) -> bool {
+    crate::core::cpu::has_avx2() && len <= i32::MAX as usize
+}
 
 #[derive(Clone)]
 pub struct RayMap {
@@ -50,6 +56,12 @@ impl RayMap {
         )
     }
 
+    /// [`RayMap::from_grid`] through `cache`.
+    pub fn from_grid_cached(grid: &crate::world::OccupancyGrid, cache: &MapCache) -> Self {
+        let key = grid.add_to_key(CacheKey::new::<RayMap>());
+        cache.get_or_build(&key, || RayMap::from_grid(grid))
+    }
+
     pub fn new(
         width: usize,
         height: usize,
@@ -68,7 +80,7 @@ impl RayMap {
             tw,
             bounds: Bounds::new(width, height, resolution),
             dist: vec![CAP; tw * th * TILE * TILE + PAD],
-            avx2: crate::core::cpu::has_avx2() && tw * th * TILE * TILE + PAD <= i32::MAX as usize,
+            avx2: use_avx2(tw * th * TILE * TILE + PAD),
             faces: Faces::new(0, 0, resolution, &|_, _| false),
         };
         for r in 0..height {
@@ -384,5 +396,52 @@ impl RayMap {
             max_range,
             out,
         );
+    }
+}
+
+/// The field and faces; the walks' bounds and the kernel choice are derived again when read.
+impl Cached for RayMap {
+    const KIND: &'static str = "raymap";
+    const FORMAT: u32 = 1;
+
+    fn encode(&self, out: &mut Encoder) {
+        out.usize(self.w);
+        out.usize(self.h);
+        out.f32(self.res);
+        out.f32(self.origin[0]);
+        out.f32(self.origin[1]);
+        out.bytes(&self.dist);
+        self.faces.encode(out);
+    }
+
+    fn decode(input: &mut Decoder<'_>) -> Result<Self, Malformed> {
+        let (w, h) = (input.usize()?, input.usize()?);
+        let res = input.f32()?;
+        let origin = [input.f32()?, input.f32()?];
+        let dist = input.bytes()?.to_vec();
+        let faces = Faces::decode(input)?;
+        let tw = w.div_ceil(TILE).max(1);
+        let th = h.div_ceil(TILE).max(1);
+        let len = tw
+            .checked_mul(th)
+            .and_then(|n| n.checked_mul(TILE * TILE))
+            .and_then(|n| n.checked_add(PAD));
+        if len != Some(dist.len()) {
+            return Err(Malformed("ray map: field size"));
+        }
+        if faces.tile_counts() != (w.div_ceil(FACE_TILE).max(1), h.div_ceil(FACE_TILE).max(1)) {
+            return Err(Malformed("ray map: face tiles"));
+        }
+        Ok(RayMap {
+            w,
+            h,
+            res,
+            origin,
+            tw,
+            bounds: Bounds::new(w, h, res),
+            avx2: use_avx2(dist.len()),
+            dist,
+            faces,
+        })
     }
 }

@@ -3,6 +3,7 @@
 //! Every edit goes through [`StaticWorld::set_cells`] so all views stay consistent.
 
 use super::raymap::RayMap;
+use crate::core::cache::MapCache;
 use crate::world::grid::{Cell, OccupancyGrid};
 use bevy_ecs::prelude::Resource;
 
@@ -20,7 +21,12 @@ pub struct StaticWorld {
 
 impl StaticWorld {
     pub fn new(grid: OccupancyGrid) -> Self {
-        let rays = RayMap::from_grid(&grid);
+        Self::new_cached(grid, &MapCache::disabled())
+    }
+
+    /// [`StaticWorld::new`] with the ray map read from `cache` when it holds this grid's.
+    pub fn new_cached(grid: OccupancyGrid, cache: &MapCache) -> Self {
+        let rays = RayMap::from_grid_cached(&grid, cache);
         StaticWorld {
             grid,
             rays,

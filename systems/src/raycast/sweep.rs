@@ -11,6 +11,7 @@
 //! rays.
 
 use super::fan::{Fan, MARGIN, atan2_approx};
+use crate::core::cache::{Decoder, Encoder, Malformed};
 use std::f32::consts::TAU;
 
 /// Cells per side of a tile. Faces are merged along straight runs within a tile, and a tile is
@@ -293,6 +294,72 @@ impl Faces {
 
     pub fn tile_counts(&self) -> (usize, usize) {
         (self.tw, self.th)
+    }
+
+    /// Every field, for the on-disk cache ([`crate::core::cache`]).
+    pub fn encode(&self, out: &mut Encoder) {
+        out.usize(self.tw);
+        out.usize(self.th);
+        out.f32(self.res);
+        out.usize(self.tiles.len());
+        for t in &self.tiles {
+            t.groups.iter().for_each(|&g| out.u32(g));
+            let flat: Vec<f32> = t.faces.iter().flat_map(|f| [f.at, f.lo, f.hi]).collect();
+            out.f32s(&flat);
+        }
+        out.usize(self.offsets.len());
+        for &(dx, dy, d) in &self.offsets {
+            out.u32(dx as u16 as u32 | (dy as u16 as u32) << 16);
+            out.f32(d);
+        }
+    }
+
+    /// What [`Faces::encode`] wrote.
+    pub fn decode(input: &mut Decoder<'_>) -> Result<Faces, Malformed> {
+        let (tw, th) = (input.usize()?, input.usize()?);
+        let res = input.f32()?;
+        let n = input.count(4 * (FACINGS + 1) + 8)?;
+        if Some(n) != tw.checked_mul(th) {
+            return Err(Malformed("faces: tile count"));
+        }
+        let mut tiles = Vec::with_capacity(n);
+        for _ in 0..n {
+            let mut groups = [0u32; FACINGS + 1];
+            for g in &mut groups {
+                *g = input.u32()?;
+            }
+            let flat = input.f32s()?;
+            if flat.len() % 3 != 0 {
+                return Err(Malformed("faces: a face's fields"));
+            }
+            let faces: Vec<Face> = flat
+                .chunks_exact(3)
+                .map(|f| Face {
+                    at: f[0],
+                    lo: f[1],
+                    hi: f[2],
+                })
+                .collect();
+            let ordered = groups[0] == 0 && groups.windows(2).all(|g| g[0] <= g[1]);
+            if !ordered || groups[FACINGS] as usize != faces.len() {
+                return Err(Malformed("faces: groups"));
+            }
+            tiles.push(Tile { faces, groups });
+        }
+        let m = input.count(8)?;
+        let mut offsets = Vec::with_capacity(m);
+        for _ in 0..m {
+            let packed = input.u32()?;
+            let d = input.f32()?;
+            offsets.push((packed as u16 as i16, (packed >> 16) as u16 as i16, d));
+        }
+        Ok(Faces {
+            tw,
+            th,
+            res,
+            tiles,
+            offsets,
+        })
     }
 
     pub fn memory_bytes(&self) -> usize {

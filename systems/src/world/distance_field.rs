@@ -20,6 +20,7 @@
 //! truncated distance depends only on obstacles within `max_dist` of it.
 
 use super::grid::OccupancyGrid;
+use crate::core::cache::{CacheKey, Cached, Decoder, Encoder, Malformed, MapCache};
 use rayon::prelude::*;
 
 /// Byte value meaning "at least `max_dist` from any obstacle" (also used outside the grid).
@@ -257,6 +258,14 @@ impl DistanceField {
         f
     }
 
+    /// [`DistanceField::new`] through `cache`.
+    pub fn new_cached(grid: &OccupancyGrid, max_dist: f64, cache: &MapCache) -> Self {
+        let key = grid
+            .add_to_key(CacheKey::new::<DistanceField>())
+            .f64(max_dist);
+        cache.get_or_build(&key, || DistanceField::new(grid, max_dist))
+    }
+
     /// Margin of cells whose obstacles can influence a cell's truncated distance.
     fn margin(&self) -> usize {
         (self.max_dist / self.resolution).ceil() as usize + 1
@@ -340,6 +349,39 @@ impl DistanceField {
 
     pub fn memory_bytes(&self) -> usize {
         self.cells.len()
+    }
+}
+
+/// Every field.
+impl Cached for DistanceField {
+    const KIND: &'static str = "distance_field";
+    const FORMAT: u32 = 1;
+
+    fn encode(&self, out: &mut Encoder) {
+        out.usize(self.width);
+        out.usize(self.height);
+        out.f64(self.resolution);
+        out.f64(self.origin[0]);
+        out.f64(self.origin[1]);
+        out.f64(self.max_dist);
+        out.f64(self.step);
+        out.bytes(&self.cells);
+    }
+
+    fn decode(input: &mut Decoder<'_>) -> Result<Self, Malformed> {
+        let f = DistanceField {
+            width: input.usize()?,
+            height: input.usize()?,
+            resolution: input.f64()?,
+            origin: [input.f64()?, input.f64()?],
+            max_dist: input.f64()?,
+            step: input.f64()?,
+            cells: input.bytes()?.to_vec(),
+        };
+        if Some(f.cells.len()) != f.width.checked_mul(f.height) {
+            return Err(Malformed("distance field: cell count"));
+        }
+        Ok(f)
     }
 }
 

@@ -1,6 +1,8 @@
 //! Occupancy grid in the world frame. Row 0 is the BOTTOM row (the map_server image's last row),
 //! so cell (col, row) covers [ox + col·res, ox + (col+1)·res) × [oy + row·res, oy + (row+1)·res).
 
+use crate::core::cache::CacheKey;
+
 /// A cell's state, with the ROS `nav_msgs/OccupancyGrid` values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
@@ -30,6 +32,18 @@ impl OccupancyGrid {
             origin,
             cells: vec![fill; width * height],
         }
+    }
+
+    /// `key` fed with every field: size, resolution, origin and cells (the on-disk cache's key
+    /// of a structure computed from the grid).
+    pub fn add_to_key(&self, key: CacheKey) -> CacheKey {
+        let cells: Vec<u8> = self.cells.iter().map(|&c| c as u8).collect();
+        key.u64(self.width as u64)
+            .u64(self.height as u64)
+            .f64(self.resolution)
+            .f64(self.origin[0])
+            .f64(self.origin[1])
+            .bytes(&cells)
     }
 
     pub fn index(&self, col: usize, row: usize) -> usize {

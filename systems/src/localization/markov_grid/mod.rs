@@ -117,6 +117,18 @@ fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
         .collect()
 }
 
+/// The largest value by [`f32::total_cmp`] and its index, the first of equals: a maximum of
+/// integer keys (`total_cmp`'s own), which vectorises, then the first key equal to it.
+fn argmax(v: &[f32]) -> Option<(usize, f32)> {
+    let key = |x: f32| {
+        let b = x.to_bits() as i32;
+        b ^ (((b >> 31) as u32) >> 1) as i32
+    };
+    let top = v.iter().map(|&x| key(x)).max()?;
+    let i = v.iter().position(|&x| key(x) == top)?;
+    Some((i, v[i]))
+}
+
 /// A cell centre `(x, y, heading offset, belief)` in the estimate's neighbourhood.
 type WeightedCell = (f64, f64, f64, f64);
 
@@ -438,11 +450,7 @@ impl MarkovGrid {
     /// The most probable cell, refined over its 3 × 3 × 3 neighbourhood.
     pub fn estimate_pose(&self) -> Option<PoseEstimate> {
         let l = &self.layout;
-        let (best, &p) = self
-            .belief
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)))?;
+        let (best, p) = argmax(&self.belief)?;
         if p <= 0.0 {
             return None;
         }

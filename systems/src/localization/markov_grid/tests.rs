@@ -124,3 +124,48 @@ fn converges_from_global_initialisation_and_tracks() {
         errors.len()
     );
 }
+
+/// The most probable cell is the one `max_by` with `total_cmp`, ties to the first, picks: on
+/// ties, zeros of both signs, subnormals, infinities and NaNs.
+#[test]
+fn argmax_is_total_cmp_s_first_maximum() {
+    let plain = |v: &[f32]| {
+        v.iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)))
+            .map(|(i, &x)| (i, x.to_bits()))
+    };
+    let specials = [
+        0.0,
+        -0.0,
+        1e-40,
+        -1e-40,
+        0.25,
+        0.25,
+        -3.0,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        -f32::NAN,
+    ];
+    let mut x = 12345u64;
+    for len in [0, 1, 2, 7, 64, 1000] {
+        for round in 0..50 {
+            let v: Vec<f32> = (0..len)
+                .map(|_| {
+                    x = x
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    let pick = (x >> 33) as usize;
+                    if round % 2 == 0 {
+                        specials[pick % specials.len()]
+                    } else {
+                        (pick % 5) as f32 * 0.125
+                    }
+                })
+                .collect();
+            let fast = argmax(&v).map(|(i, x)| (i, x.to_bits()));
+            assert_eq!(fast, plain(&v), "{v:?}");
+        }
+    }
+}

@@ -176,27 +176,22 @@ pub struct Mcl {
 impl Mcl {
     pub fn new(config: MclConfig, map: &LocalizationMap, mut rng: SimRng) -> Self {
         let n = config.max_particles.max(1);
-        let (mut xs, mut ys, mut ths) = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-        );
-        for _ in 0..n {
-            let (x, y, th) = match config.init {
-                InitialBelief::Global => map.random_free_pose(&mut || rng.random::<f64>()),
-                InitialBelief::Gaussian { pose, sd } => {
+        let poses: Vec<[f64; 3]> = match config.init {
+            InitialBelief::Global => map.random_free_poses(n, &mut || rng.random::<f64>()),
+            InitialBelief::Gaussian { pose, sd } => (0..n)
+                .map(|_| {
                     let mut g = || -> f64 { StandardNormal.sample(&mut rng) };
-                    (
+                    [
                         pose.x + sd[0] * g(),
                         pose.y + sd[1] * g(),
                         wrap_angle(pose.theta + sd[2] * g()),
-                    )
-                }
-            };
-            xs.push(x);
-            ys.push(y);
-            ths.push(th);
-        }
+                    ]
+                })
+                .collect(),
+        };
+        let xs = poses.iter().map(|p| p[0]).collect();
+        let ys = poses.iter().map(|p| p[1]).collect();
+        let ths = poses.iter().map(|p| p[2]).collect();
         Mcl {
             config,
             xs,

@@ -19,6 +19,7 @@
 
 use super::graph::RoadGraph;
 use super::surface::Surface;
+use crate::core::cache::{CacheKey, Cached, Decoder, Encoder, Malformed, MapCache};
 
 /// Class of the ground off the roads.
 pub const GRASS: u8 = 0;
@@ -116,6 +117,32 @@ impl SurfaceRaster {
         r
     }
 
+    /// [`SurfaceRaster::build`] through `cache`.
+    pub fn build_cached(
+        graph: &RoadGraph,
+        resolution: f64,
+        margin: f64,
+        cache: &MapCache,
+    ) -> SurfaceRaster {
+        // what `build` reads: node positions, edges, road widths and surfaces
+        let mut key = CacheKey::new::<SurfaceRaster>()
+            .f64(resolution)
+            .f64(margin)
+            .u64(graph.nodes.len() as u64);
+        for n in &graph.nodes {
+            key = key.f64(n.pos[0]).f64(n.pos[1]);
+        }
+        key = key.u64(graph.roads.len() as u64);
+        for r in &graph.roads {
+            key = key.f64(r.width).u64(surface_class(r.surface).into());
+        }
+        key = key.u64(graph.edges.len() as u64);
+        for e in &graph.edges {
+            key = key.u64(e.a as u64).u64(e.b as u64).u64(e.road as u64);
+        }
+        cache.get_or_build(&key, || SurfaceRaster::build(graph, resolution, margin))
+    }
+
     /// Sets every cell whose centre is within `radius` of segment `a`–`b` to `class`.
     fn fill_capsule(&mut self, a: [f64; 2], b: [f64; 2], radius: f64, class: u8) {
         let res = self.resolution;
@@ -174,6 +201,35 @@ impl SurfaceRaster {
     /// Memory held by the cells (bytes).
     pub fn bytes(&self) -> usize {
         self.cells.len()
+    }
+}
+
+/// Every field; the cells as runs (mostly grass).
+impl Cached for SurfaceRaster {
+    const KIND: &'static str = "road_surface";
+    const FORMAT: u32 = 1;
+
+    fn encode(&self, out: &mut Encoder) {
+        out.f64(self.resolution);
+        out.f64(self.origin[0]);
+        out.f64(self.origin[1]);
+        out.usize(self.width);
+        out.usize(self.height);
+        out.byte_runs(&self.cells);
+    }
+
+    fn decode(input: &mut Decoder<'_>) -> Result<Self, Malformed> {
+        let r = SurfaceRaster {
+            resolution: input.f64()?,
+            origin: [input.f64()?, input.f64()?],
+            width: input.usize()?,
+            height: input.usize()?,
+            cells: input.byte_runs()?,
+        };
+        if Some(r.cells.len()) != r.width.checked_mul(r.height) {
+            return Err(Malformed("road surface: cell count"));
+        }
+        Ok(r)
     }
 }
 
