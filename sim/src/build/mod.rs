@@ -230,10 +230,12 @@ pub fn build_world_with(
         crate::build::outdoor::insert_outdoor_world(&mut world, scenario, cache);
     }
     times.lap("outdoor world");
+    let mut localizers = build_localizers(&world, scenario)?.into_iter();
     let mut robots = Vec::with_capacity(scenario.robots.len());
     for (i, r) in scenario.robots.iter().enumerate() {
         let body = physics.add_robot(i as u32, &r.start, &r.footprint);
-        let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body)?;
+        let items = localizers.next().unwrap_or_default();
+        let e = spawn_robot(&mut world, scenario.seed, i as u32, r, body, items)?;
         if live {
             crate::build::outdoor::insert_outdoor_parts(&mut world, scenario.seed, e, r);
         }
@@ -322,12 +324,48 @@ fn odometry_model(kin: &Kinematics, enc: &systems::sensors::EncoderSpec) -> Odom
     }
 }
 
+/// Every robot's localizers, in robot order. They are built on the kernel threads, one job per
+/// localizer: each draws only from its own stream (`stream_rng(seed, robot,
+/// "localizer/<name>")`), so they are the same whatever the number of threads; the first error
+/// in scenario order is the one reported.
+fn build_localizers(world: &World, scenario: &Scenario) -> anyhow::Result<Vec<Vec<Localizer>>> {
+    type Job<'a> = (&'a RobotConfig, usize, Option<anyhow::Result<Localizer>>);
+    let mut jobs: Vec<Job> = scenario
+        .robots
+        .iter()
+        .flat_map(|r| (0..r.localizers.len()).map(move |k| (r, k, None)))
+        .collect();
+    let map = world.get_resource::<LocalizationMap>();
+    let seed = scenario.seed;
+    world
+        .resource::<KernelPool>()
+        .for_each(&mut jobs, |(r, k, out)| {
+            let l = &r.localizers[*k];
+            let rng = stream_rng(seed, &r.name, &format!("localizer/{}", l.name));
+            *out = Some(new_filter(&l.kind, map, rng).map(|f| Localizer::new(l.name.clone(), f)));
+        });
+    let mut built = jobs.into_iter();
+    scenario
+        .robots
+        .iter()
+        .map(|r| {
+            (0..r.localizers.len())
+                .map(|_| match built.next() {
+                    Some((_, _, Some(l))) => l,
+                    _ => Err(anyhow::anyhow!("a localizer of {} was not built", r.name)),
+                })
+                .collect()
+        })
+        .collect()
+}
+
 fn spawn_robot(
     world: &mut World,
     seed: u64,
     index: u32,
     r: &RobotConfig,
     body: systems::body::PhysicsBody,
+    localizers: Vec<Localizer>,
 ) -> anyhow::Result<Entity> {
     let half_width = r.footprint.bounding_radius() + 0.1;
     let mut behaviour = Behaviour::new(
@@ -376,23 +414,11 @@ fn spawn_robot(
         ));
     }
     let id = e.id();
-    if !r.localizers.is_empty() {
-        let items = {
-            let map = world.resource::<LocalizationMap>();
-            r.localizers
-                .iter()
-                .map(|l| {
-                    let rng = stream_rng(seed, &r.name, &format!("localizer/{}", l.name));
-                    Ok(Localizer::new(
-                        l.name.clone(),
-                        new_filter(&l.kind, Some(map), rng)?,
-                    ))
-                })
-                .collect::<anyhow::Result<_>>()?
-        };
-        world
-            .entity_mut(id)
-            .insert((Localizers { items }, LocalizationSamples::default()));
+    if !localizers.is_empty() {
+        world.entity_mut(id).insert((
+            Localizers { items: localizers },
+            LocalizationSamples::default(),
+        ));
     }
     Ok(id)
 }
