@@ -287,6 +287,14 @@ impl Encoder {
     pub fn f64(&mut self, v: f64) {
         self.u64(v.to_bits());
     }
+    /// A grid's frame: width and height in cells, metres per cell, origin.
+    pub fn grid_frame(&mut self, width: usize, height: usize, resolution: f64, origin: [f64; 2]) {
+        self.usize(width);
+        self.usize(height);
+        self.f64(resolution);
+        self.f64(origin[0]);
+        self.f64(origin[1]);
+    }
     /// A length, then the bytes.
     pub fn bytes(&mut self, b: &[u8]) {
         self.usize(b.len());
@@ -363,6 +371,15 @@ impl<'a> Decoder<'a> {
     }
     pub fn f64(&mut self) -> Result<f64, Malformed> {
         Ok(f64::from_bits(self.u64()?))
+    }
+    /// What [`Encoder::grid_frame`] wrote: (width, height, resolution, origin).
+    pub fn grid_frame(&mut self) -> Result<(usize, usize, f64, [f64; 2]), Malformed> {
+        Ok((
+            self.usize()?,
+            self.usize()?,
+            self.f64()?,
+            [self.f64()?, self.f64()?],
+        ))
     }
     /// A length of items of `size` bytes, checked against what is left.
     fn len_of(&mut self, size: usize) -> Result<usize, Malformed> {

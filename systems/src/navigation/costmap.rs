@@ -165,20 +165,17 @@ impl Cached for Costmap {
     const FORMAT: u32 = 1;
 
     fn encode(&self, out: &mut Encoder) {
-        out.usize(self.width);
-        out.usize(self.height);
-        out.f64(self.resolution);
-        out.f64(self.origin[0]);
-        out.f64(self.origin[1]);
+        out.grid_frame(self.width, self.height, self.resolution, self.origin);
         out.bytes(&self.costs);
     }
 
     fn decode(input: &mut Decoder<'_>) -> Result<Self, Malformed> {
+        let (width, height, resolution, origin) = input.grid_frame()?;
         let m = Costmap {
-            width: input.usize()?,
-            height: input.usize()?,
-            resolution: input.f64()?,
-            origin: [input.f64()?, input.f64()?],
+            width,
+            height,
+            resolution,
+            origin,
             costs: input.bytes()?.to_vec(),
         };
         if Some(m.costs.len()) != m.width.checked_mul(m.height) {

@@ -358,22 +358,19 @@ impl Cached for DistanceField {
     const FORMAT: u32 = 1;
 
     fn encode(&self, out: &mut Encoder) {
-        out.usize(self.width);
-        out.usize(self.height);
-        out.f64(self.resolution);
-        out.f64(self.origin[0]);
-        out.f64(self.origin[1]);
+        out.grid_frame(self.width, self.height, self.resolution, self.origin);
         out.f64(self.max_dist);
         out.f64(self.step);
         out.bytes(&self.cells);
     }
 
     fn decode(input: &mut Decoder<'_>) -> Result<Self, Malformed> {
+        let (width, height, resolution, origin) = input.grid_frame()?;
         let f = DistanceField {
-            width: input.usize()?,
-            height: input.usize()?,
-            resolution: input.f64()?,
-            origin: [input.f64()?, input.f64()?],
+            width,
+            height,
+            resolution,
+            origin,
             max_dist: input.f64()?,
             step: input.f64()?,
             cells: input.bytes()?.to_vec(),
