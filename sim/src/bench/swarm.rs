@@ -325,20 +325,27 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     }
     let per_hospital = o.per_hospital.map(|n| n as usize);
     let maps = SwarmMaps::new(per_hospital)?;
+    let runs: Vec<(usize, usize)> = o
+        .beams
+        .iter()
+        .flat_map(|&b| o.robots.iter().map(move |&n| (b, n)))
+        .collect();
     // every population is placed before the first one runs, so one that does not fit fails at
-    // once; at constant density one copy of the hospital must hold its share
-    match per_hospital {
+    // once; at constant density, where each population has its own map and they are placed as
+    // they run, one copy of the hospital must hold its share
+    let mut placed: Vec<Option<Scenario>> = match per_hospital {
         Some(per) => {
             swarm_scenario(&maps.hospital, per, 180, o.duration)
                 .map_err(|e| anyhow::anyhow!("--per-hospital {per}: {e}"))?;
+            runs.iter().map(|_| None).collect()
         }
         None => {
             let (grid, _) = maps.for_robots(0);
-            for &n in &o.robots {
-                swarm_scenario(&grid, n, 180, o.duration)?;
-            }
+            runs.iter()
+                .map(|&(beams, n)| swarm_scenario(&grid, n, beams, o.duration).map(Some))
+                .collect::<anyhow::Result<_>>()?
         }
-    }
+    };
     if !o.json {
         match per_hospital {
             Some(per) => println!(
@@ -364,13 +371,12 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
             "robots", "beams", "sim s", "wall s", "× real time", "rays/s", "µs/robot-step"
         );
     }
-    let runs = o
-        .beams
-        .iter()
-        .flat_map(|&b| o.robots.iter().map(move |&n| (b, n)));
-    for (beams, n) in runs {
+    for (k, &(beams, n)) in runs.iter().enumerate() {
         let (grid, map) = maps.for_robots(n);
-        let mut sc = swarm_scenario(&grid, n, beams, o.duration)?;
+        let mut sc = match placed[k].take() {
+            Some(sc) => sc,
+            None => swarm_scenario(&grid, n, beams, o.duration)?,
+        };
         drop(grid);
         if let Some(d) = o.mcl {
             localize_with_mcl(&mut sc, d);
