@@ -3,7 +3,10 @@
 
 use super::*;
 use crate::run::{Finished, Simulation};
-use crate::scenario::{assets_dir, parse_scenario};
+use crate::scenario::{
+    EncoderFile, KinematicsFile, LaserFile, LocalizerFile, LocalizerType, NavigationFile,
+    RobotConfig, RouteFile, SensorName, SlamFile, SlamType, TaskFile, assets_dir, parse_scenario,
+};
 
 /// Parses scenario text as a file in the bundled scenarios' folder would be.
 fn parse(text: &str) -> Result<Scenario, ScenarioError> {
