@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every test of the workspace, in release mode.
+# Runs every test of the workspace, in release mode, then the Python package's tests.
 #
 # The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
 # the Python SDK's RrdReader), Foxglove's Python MCAP readers (mcap, mcap-ros2-support) and evo
@@ -42,3 +42,13 @@ export SIM_EVO_VENV="$evo_venv"
 export SIM_REQUIRE_TOOLS=1
 
 cargo test --release --workspace
+
+# The Python package (sim/python): `pip install` builds it with maturin (sharing the cargo
+# target directory, so only the extension itself is compiled again) into a fresh virtual
+# environment, then its pytest suite runs against the installed package.
+py_venv="$(mktemp -d)/venv"
+trap 'rm -rf "$(dirname "$py_venv")"' EXIT
+python3 -m venv "$py_venv"
+echo "building and installing the Python package into a fresh virtual environment"
+"$py_venv/bin/pip" install --quiet --disable-pip-version-check "./sim/python[test]"
+(cd sim/python && "$py_venv/bin/python" -m pytest -p no:cacheprovider -q tests)

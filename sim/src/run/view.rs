@@ -13,11 +13,12 @@ use systems::localization::{Filter, Localizers, WheelOdometry};
 use systems::matching::ProbGrid;
 use systems::navigation::Navigator;
 use systems::navigation::navigator::Phase;
-use systems::sensors::camera::CameraFrame;
+use systems::sensors::camera::{CameraFrame, CameraImage};
 use systems::sensors::{
-    CameraImages, CompassReading, CompassReadings, EncoderReading, EncoderReadings, GpsFix,
+    Camera, CameraImages, CompassReading, CompassReadings, EncoderReading, EncoderReadings, GpsFix,
     GpsReadings, LaserScan, LaserScans, LaserTruth, SonarReadings,
 };
+use systems::world::roads::{RoadSurface, SurfaceRaster};
 
 /// A robot's linear and angular velocity (m/s, rad/s).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -108,6 +109,21 @@ impl<'w> RobotView<'w> {
     /// The latest camera frame (None without a camera, or before its first frame).
     pub fn camera(&self) -> Option<&'w CameraFrame> {
         self.get::<CameraImages>()?.frame.as_ref()
+    }
+
+    /// The latest camera frame's pixels (None without a camera, or before its first frame):
+    /// rendered when asked, as the recording renders it, from the frame's pose and draws.
+    pub fn camera_image(&self) -> Option<CameraImage> {
+        let frame = self.camera()?;
+        let camera = self.get::<Camera>()?;
+        let image = match self.world.get_resource::<RoadSurface>() {
+            Some(surface) => camera.render(frame, &surface.0),
+            None => camera.render(frame, &SurfaceRaster::empty()),
+        };
+        Some(CameraImage {
+            stamp: frame.stamp,
+            ..image
+        })
     }
 
     /// Every localizer and SLAM system of the robot, in the scenario's order.
