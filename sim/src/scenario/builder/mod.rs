@@ -18,28 +18,17 @@ use super::slam::SlamList;
 use std::path::{Path, PathBuf};
 use systems::core::Pose2;
 
+mod deferred;
 mod robot;
 mod tables;
 #[cfg(test)]
 mod tests;
 
+use deferred::Deferred;
 pub use robot::RobotBuilder;
 
 /// What errors of a built scenario name instead of a file.
 pub const CODE_LABEL: &str = "<code>";
-
-/// A value given to a builder that could not become part of the file model (a type name that
-/// is no type): its key and message, reported by `build` as the file's parse error would be.
-type Deferred = Option<(KeyPath, String)>;
-
-/// A name read as the file reads it (`"mcl"` → [`LocalizerType::Mcl`]), with serde's message
-/// when it is none of the names.
-fn parse_name<T: serde::de::DeserializeOwned>(name: &str) -> Result<T, String> {
-    use serde::de::IntoDeserializer;
-    let d: serde::de::value::StringDeserializer<serde::de::value::Error> =
-        name.to_string().into_deserializer();
-    T::deserialize(d).map_err(|e| e.to_string())
-}
 
 impl From<[f64; 2]> for PointOrPlace {
     fn from(p: [f64; 2]) -> Self {

@@ -1,6 +1,6 @@
 //! [`RobotBuilder`]: one robot of a scenario built in code.
 
-use super::{Deferred, parse_name};
+use super::deferred::{Deferred, parse_name};
 use crate::scenario::check::PointOrPlace;
 use crate::scenario::error::KeyPath;
 use crate::scenario::file::{
