@@ -50,5 +50,5 @@ py_venv="$(mktemp -d)/venv"
 trap 'rm -rf "$(dirname "$py_venv")"' EXIT
 python3 -m venv "$py_venv"
 echo "building and installing the Python package into a fresh virtual environment"
-"$py_venv/bin/pip" install --quiet --disable-pip-version-check "./sim/python[test]"
+"$py_venv/bin/pip" install --quiet --disable-pip-version-check "./sim/python[test,gym]"
 (cd sim/python && "$py_venv/bin/python" -m pytest -p no:cacheprovider -q tests)

@@ -11,6 +11,7 @@ mod convert;
 mod errors;
 mod robot;
 mod simulation;
+mod vector;
 
 use pyo3::prelude::*;
 
@@ -19,6 +20,7 @@ fn _sim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     errors::register(m)?;
     m.add_class::<simulation::PySimulation>()?;
+    m.add_class::<vector::PyVecSimulation>()?;
     m.add_class::<robot::PyRobot>()?;
     m.add_class::<robot::PyScan>()?;
     m.add_class::<robot::PyEstimate>()?;

@@ -158,6 +158,30 @@ impl PyRobot {
         self.with_view(py, |v| Ok(v.odometry().map(pose)))
     }
 
+    /// The laser's parameters: a dict of `beams`, `fov`, `increment`, `min_range`,
+    /// `max_range` (m, rad) and `rate` (Hz); None without a laser.
+    #[getter]
+    fn laser<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Source::Simulation(s) = &self.source else {
+            return Err(SimError::new_err(
+                "the laser's parameters are read from the simulation's robot, not an observation",
+            ));
+        };
+        s.get().with_sim(py, |sim| {
+            let Some(l) = &sim.scenario().robots[self.index].laser else {
+                return Ok(None);
+            };
+            let d = PyDict::new(py);
+            d.set_item("beams", l.beams())?;
+            d.set_item("fov", l.fov)?;
+            d.set_item("increment", l.increment)?;
+            d.set_item("min_range", l.min_range)?;
+            d.set_item("max_range", l.max_range)?;
+            d.set_item("rate", l.rate)?;
+            Ok(Some(d))
+        })
+    }
+
     /// The latest laser scan (of this tick or an earlier one), or None.
     #[getter]
     fn scan(&self, py: Python<'_>) -> PyResult<Option<PyScan>> {

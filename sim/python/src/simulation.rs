@@ -36,7 +36,7 @@ pub struct PySimulation {
 }
 
 /// The builder's options every constructor takes.
-struct Options<'py> {
+pub struct Options<'py> {
     seed: Option<u64>,
     duration: Option<f64>,
     threads: usize,
@@ -71,7 +71,7 @@ const OPTIONS: &str =
 
 impl<'py> Options<'py> {
     /// The keyword options of a constructor, each checked for its type.
-    fn from_kwargs(kwargs: Option<&Bound<'py, PyDict>>) -> PyResult<Self> {
+    pub fn from_kwargs(kwargs: Option<&Bound<'py, PyDict>>) -> PyResult<Self> {
         let mut o = Options {
             seed: None,
             duration: None,
@@ -125,7 +125,8 @@ impl<'py> Options<'py> {
         Ok(o)
     }
 
-    fn apply(self, mut b: SimulationBuilder, raised: &Raised) -> PyResult<SimulationBuilder> {
+    /// The options that shape the world (seed, duration, threads, overrides, cache).
+    pub fn apply_plain(&self, mut b: SimulationBuilder) -> PyResult<SimulationBuilder> {
         if let Some(s) = self.seed {
             b = b.seed(s);
         }
@@ -140,7 +141,7 @@ impl<'py> Options<'py> {
             )));
         }
         b = b.threads(self.threads);
-        if let Some(set) = self.set {
+        if let Some(set) = &self.set {
             for (k, v) in set.iter() {
                 let key: String = k.extract().map_err(|_| {
                     PyValueError::new_err("set: expected string keys (`robots[0].seed`)")
@@ -149,6 +150,17 @@ impl<'py> Options<'py> {
                 b = b.set(&key, &text);
             }
         }
+        b = b.cache(if self.cache {
+            sim::cache::from_env(false)
+        } else {
+            systems::core::cache::MapCache::disabled()
+        });
+        Ok(b)
+    }
+
+    /// Every option: the world's, the outputs and the controllers.
+    fn apply(self, b: SimulationBuilder, raised: &Raised) -> PyResult<SimulationBuilder> {
+        let mut b = self.apply_plain(b)?;
         if let Some(p) = self.rrd {
             b = b.rrd(p);
         }
@@ -161,11 +173,6 @@ impl<'py> Options<'py> {
         if let Some(p) = self.save_map {
             b = b.save_map(p);
         }
-        b = b.cache(if self.cache {
-            sim::cache::from_env(false)
-        } else {
-            systems::core::cache::MapCache::disabled()
-        });
         if let Some(ctrls) = self.controllers {
             for (k, v) in ctrls.iter() {
                 let robot: String = k.extract().map_err(|_| {

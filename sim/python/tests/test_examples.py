@@ -16,7 +16,7 @@ def load(name: str):
 
 
 def test_every_example_is_tested_here():
-    tested = {"scripted_hospital", "maze_controller"}
+    tested = {"scripted_hospital", "maze_controller", "parameter_sweep", "vector_rollout"}
     assert {p.stem for p in EXAMPLES.glob("*.py")} == tested
 
 
@@ -47,3 +47,15 @@ def test_maze_controller_follows_the_wall(tmp_path):
     driven = float(out.stdout.split()[1])
     assert driven > 8.0, out.stdout
     assert rrd.stat().st_size > 0
+
+
+def test_parameter_sweep_gives_a_row_per_run():
+    rows = load("parameter_sweep").sweep(10.0)
+    assert len(rows) == 9
+    assert {r["particles"] for r in rows} == {200, 1000, 5000}
+    assert all(r["ate_m"] is None or r["ate_m"] >= 0 for r in rows)
+
+
+def test_vector_rollout_reports_its_rate():
+    r = load("vector_rollout").rollout(4, 60, 2)
+    assert r["env_steps_per_s"] > 0 and r["episodes"] >= 0

@@ -107,18 +107,30 @@ pub struct Reusable {
     localization_map: Option<LocalizationMap>,
     /// The navigation costmaps.
     costmaps: Option<NavCostmaps>,
+    /// The kernel pool (its threads, or a pool the program gave).
+    pool: Option<KernelPool>,
 }
 
 impl Reusable {
     /// Takes the seed-independent parts out of a built world, unless a door has moved (door
     /// events edit them; the next world starts with every door open).
     pub fn take(world: &mut World) -> Self {
+        let pool = world.remove_resource::<KernelPool>();
         if world.resource::<StaticWorld>().version != 0 {
-            return Reusable::default();
+            return Reusable::with_pool(pool);
         }
         Reusable {
             localization_map: world.remove_resource::<LocalizationMap>(),
             costmaps: world.remove_resource::<NavCostmaps>(),
+            pool,
+        }
+    }
+
+    /// Nothing to reuse but the kernel pool (none: the build starts its own).
+    pub fn with_pool(pool: Option<KernelPool>) -> Self {
+        Reusable {
+            pool,
+            ..Reusable::default()
         }
     }
 }
@@ -172,8 +184,11 @@ pub fn build_world_with(
     let live = mode == BuildMode::Live;
     let mut times = BuildTimes::start();
     let mut world = World::new();
-    let pool = KernelPool::new(threads)
-        .map_err(|e| anyhow::anyhow!("cannot start {threads} kernel threads: {e}"))?;
+    let pool = match reuse.pool.clone() {
+        Some(pool) => pool,
+        None => KernelPool::new(threads)
+            .map_err(|e| anyhow::anyhow!("cannot start {threads} kernel threads: {e}"))?,
+    };
     world.insert_resource(pool);
     world.insert_resource(SimClock::new(scenario.dt));
     times.lap("kernel pool");

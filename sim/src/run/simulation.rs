@@ -33,6 +33,7 @@ use bevy_ecs::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use systems::body::{PersonId, TruePose, Walker};
+use systems::core::pool::KernelPool;
 use systems::localization::{Filter, MapLocalizer, ScanEstimator};
 use systems::navigation::Navigator;
 use systems::navigation::road_drive::{RoadNavigator, RoadPhase};
@@ -92,6 +93,8 @@ pub struct SimulationBuilder {
     threads: usize,
     /// `None`: the process's ([`crate::cache::process_cache`]).
     cache: Option<MapCache>,
+    /// `None`: a pool of `threads` workers of the simulation's own.
+    pool: Option<KernelPool>,
     rrd: Option<PathBuf>,
     exports: RunExports,
     /// User controllers by robot name.
@@ -109,6 +112,7 @@ impl SimulationBuilder {
             duration: None,
             threads: 0,
             cache: None,
+            pool: None,
             rrd: None,
             exports: RunExports::default(),
             controllers: Vec::new(),
@@ -158,6 +162,15 @@ impl SimulationBuilder {
     /// unless the command line set it.
     pub fn cache(mut self, cache: MapCache) -> Self {
         self.cache = Some(cache);
+        self
+    }
+
+    /// Runs the world's kernels on `pool` instead of a pool of its own (`threads` then does
+    /// not apply): one pool shared by several simulations, or [`KernelPool::inline`] for
+    /// worlds that are themselves stepped side by side on another pool's workers. Results do
+    /// not depend on it.
+    pub fn kernel_pool(mut self, pool: KernelPool) -> Self {
+        self.pool = Some(pool);
         self
     }
 
@@ -275,7 +288,7 @@ impl SimulationBuilder {
             &scenario,
             self.threads,
             BuildMode::Live,
-            Reusable::default(),
+            Reusable::with_pool(self.pool),
             &cache,
         )?;
         attach_estimators(&mut world, &scenario, self.estimators.clone())?;

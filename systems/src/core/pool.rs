@@ -30,7 +30,8 @@ const STAY_AWAKE: Duration = Duration::from_millis(3);
 
 #[derive(Resource, Clone)]
 pub struct KernelPool {
-    pool: Arc<rayon::ThreadPool>,
+    /// None: an inline pool, running every section on the calling thread.
+    pool: Option<Arc<rayon::ThreadPool>>,
     /// Workers kept awake after a parallel section: at most one less than the cores, so the
     /// calling thread's serial work keeps a core of its own.
     awake: usize,
@@ -55,15 +56,28 @@ impl KernelPool {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let awake = pool.current_num_threads().min(cores).saturating_sub(1);
         Ok(KernelPool {
-            pool: Arc::new(pool),
+            pool: Some(Arc::new(pool)),
             awake,
             section: Arc::new(AtomicU64::new(0)),
             queued: Arc::new(AtomicU64::new(0)),
         })
     }
 
+    /// A pool without threads of its own: every section runs on the calling thread, and
+    /// rayon's parallel iterators in it on the pool the caller runs in (rayon's global pool
+    /// outside any). For worlds stepped side by side on another pool's workers: each world's
+    /// kernels stay on the worker stepping it, with no hand-over to a thread of its own.
+    pub fn inline() -> Self {
+        KernelPool {
+            pool: None,
+            awake: 0,
+            section: Arc::new(AtomicU64::new(0)),
+            queued: Arc::new(AtomicU64::new(0)),
+        }
+    }
+
     pub fn threads(&self) -> usize {
-        self.pool.current_num_threads()
+        self.pool.as_ref().map_or(1, |p| p.current_num_threads())
     }
 
     /// Runs `f` inside the pool (rayon's parallel iterators in it use the pool's workers). Any
@@ -71,7 +85,10 @@ impl KernelPool {
     /// wait for the next section (for `STAY_AWAKE` at most).
     pub fn install<R: Send>(&self, f: impl FnOnce() -> R + Send) -> R {
         self.section.fetch_add(1, Ordering::AcqRel);
-        let r = self.pool.install(f);
+        let Some(pool) = &self.pool else {
+            return f();
+        };
+        let r = pool.install(f);
         self.stay_awake();
         r
     }
@@ -80,14 +97,17 @@ impl KernelPool {
     /// Not from inside the pool (a nested `install`): a waiting job queued there would hold a
     /// worker that the enclosing section still needs.
     fn stay_awake(&self) {
-        if self.awake == 0 || self.pool.current_thread_index().is_some() {
+        let Some(pool) = &self.pool else {
+            return;
+        };
+        if self.awake == 0 || pool.current_thread_index().is_some() {
             return;
         }
         let this = self.section.fetch_add(1, Ordering::AcqRel) + 1;
         self.queued.fetch_add(self.awake as u64, Ordering::Relaxed);
         for _ in 0..self.awake {
             let section = self.section.clone();
-            self.pool.spawn(move || {
+            pool.spawn(move || {
                 let since = Instant::now();
                 let mut spins = 0u32;
                 while section.load(Ordering::Acquire) == this {
@@ -192,6 +212,38 @@ mod tests {
             assert!(matches!(e, PoolError::TooMany(t) if t == n), "{e}");
             assert!(e.to_string().contains("1024"), "{e}");
         }
+    }
+
+    /// An inline pool runs its sections on the calling thread, as a pool of one thread would
+    /// run them (the same items, in order), and its parallel iterators on the caller's pool.
+    #[test]
+    fn an_inline_pool_runs_on_the_calling_thread() {
+        let inline = KernelPool::inline();
+        assert_eq!(inline.threads(), 1);
+        let caller = std::thread::current().id();
+        assert_eq!(inline.install(|| std::thread::current().id()), caller);
+        let outer = KernelPool::new(2).unwrap();
+        let (on_outer, sum) = outer.install(|| {
+            inline.install(|| {
+                use rayon::prelude::*;
+                let sum: u64 = (0..1000u64).into_par_iter().map(|x| x * x).sum();
+                (rayon::current_thread_index().is_some(), sum)
+            })
+        });
+        assert!(on_outer, "ran on the outer pool's worker");
+        assert_eq!(sum, (0..1000u64).map(|x| x * x).sum::<u64>());
+        let one = KernelPool::new(1).unwrap();
+        let (mut a, mut b): (Vec<u32>, Vec<u32>) = ((0..50).collect(), (0..50).collect());
+        let (mut sa, mut sb) = (Vec::<Vec<u32>>::new(), Vec::<Vec<u32>>::new());
+        inline.for_each_with(&mut a, &mut sa, |s, x| {
+            s.push(*x);
+            *x += 1;
+        });
+        one.for_each_with(&mut b, &mut sb, |s, x| {
+            s.push(*x);
+            *x += 1;
+        });
+        assert_eq!((a, sa), (b, sb));
     }
 
     /// Every item once, whatever the count and the threads; the scratch is made once per run

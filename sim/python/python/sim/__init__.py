@@ -23,6 +23,7 @@ from ._sim import (
     ScenarioError,
     SimError,
     Simulation,
+    VecSimulation,
     __version__,
     scenarios,
 )
@@ -35,6 +36,7 @@ __all__ = [
     "ScenarioError",
     "SimError",
     "Simulation",
+    "VecSimulation",
     "__version__",
     "scenarios",
 ]

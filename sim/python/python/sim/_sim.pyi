@@ -167,6 +167,10 @@ class Robot:
     def odometry(self) -> Pose | None:
         """The pose integrated from the wheel encoders, or None without encoders."""
     @property
+    def laser(self) -> dict[str, float | int] | None:
+        """The laser's ``beams``, ``fov``, ``increment``, ``min_range``, ``max_range``,
+        ``rate``; None without a laser (read from the simulation's robot only)."""
+    @property
     def scan(self) -> Scan | None:
         """The latest laser scan, or None."""
     @property
@@ -270,3 +274,62 @@ class Observation:
     dt: float
     tick: int
     robot: Robot
+
+class VecSimulation:
+    """N independent worlds of one scenario stepped together on the engine's thread pool.
+
+    Episode k of world i runs with seed ``seed + i + k * N``. A world whose episode ended at
+    the last call (``done``), or that ``end`` marks, starts its next episode at the next
+    ``step`` (Gymnasium's ``NEXT_STEP`` autoreset): its commands are ignored and its
+    observation is the new episode's first (``reset`` true). World i with seed s follows the
+    trajectory of ``Simulation(scenario, seed=s)`` given the same commands, whatever N and the
+    thread count.
+
+    Observations are dicts of stacked arrays: ``ranges`` (N, R, B) float32 (each robot's scan
+    padded with NaN to the largest beam count B; NaN throughout without a laser), ``poses``
+    (N, R, 3), ``twists`` (N, R, 2), ``collisions`` (N, R) int64 (this episode's so far),
+    ``time`` (N,), ``done`` (N,) bool, ``reset`` (N,) bool and ``seeds`` (N,) uint64.
+    """
+
+    def __init__(
+        self,
+        scenario: str = "maze_run",
+        num_worlds: int = 8,
+        *,
+        seed: int = 0,
+        threads: int = 0,
+        reset_ticks: int = 0,
+        duration: float | None = None,
+        set: Mapping[str, str | int | float | bool] | None = None,
+        cache: bool = True,
+    ) -> None: ...
+    def reset(self, seed: int | None = None) -> dict[str, npt.NDArray[Any]]:
+        """Every world's first episode again (world i with seed ``seed + i``)."""
+    def step(
+        self,
+        commands: npt.ArrayLike,
+        ticks: int = 1,
+        end: npt.ArrayLike | None = None,
+    ) -> dict[str, npt.NDArray[Any]]:
+        """Steps every world ``ticks`` ticks with ``commands`` of shape (N, R, 2), ``(v, w)``
+        per robot; ``end`` (N,) bool ends episodes the caller decided are over."""
+    @property
+    def num_worlds(self) -> int: ...
+    @property
+    def robot_names(self) -> list[str]: ...
+    @property
+    def beams(self) -> list[int]:
+        """Each robot's beam count (0 without a laser)."""
+    @property
+    def range_max(self) -> list[float]:
+        """Each robot's laser reach (m; 0 without a laser)."""
+    @property
+    def dt(self) -> float: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def episodes(self) -> list[int]:
+        """Each world's current episode number (0 for the first)."""
+    @property
+    def seeds(self) -> list[int]:
+        """Each world's current seed."""

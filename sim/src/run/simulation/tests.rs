@@ -6,6 +6,7 @@ use super::*;
 use crate::run::{Command, RunOptions, Target, run_scenario};
 use crate::scenario::{SensorName, assets_dir, find_scenario};
 use systems::core::Pose2;
+use systems::core::pool::KernelPool;
 
 /// hospital_patrol's file without its own events (they start at 40 s anyway).
 fn patrol_text() -> String {
@@ -610,6 +611,41 @@ fn a_reset_equals_a_fresh_simulation_with_that_seed() {
     }
     let (a, b) = (s.finish().unwrap(), fresh.finish().unwrap());
     assert_eq!(summary_json(&a), summary_json(&b));
+}
+
+/// Worlds on a shared pool, or running their kernels inline on a pool stepping them side by
+/// side, give the run of a simulation with a pool of its own; a reset keeps the pool.
+#[test]
+fn a_given_kernel_pool_gives_the_same_run() {
+    let text = COURIER.replace(
+        "[[robots.tasks]]",
+        "[[robots.localization]]\nname = \"mcl\"\ntype = \"mcl\"\ninit = \"pose\"\n[[robots.tasks]]",
+    );
+    let mut own = from_text(&text, "courier").threads(1).build().unwrap();
+    own.run_for(3.0).unwrap();
+    let want = summary_json(&own.finish().unwrap());
+    let shared = KernelPool::new(2).unwrap();
+    let mut worlds: Vec<Simulation> = [shared.clone(), shared, KernelPool::inline()]
+        .into_iter()
+        .map(|pool| {
+            from_text(&text, "courier")
+                .kernel_pool(pool)
+                .build()
+                .unwrap()
+        })
+        .collect();
+    let outer = KernelPool::new(2).unwrap();
+    outer.install(|| {
+        use rayon::prelude::*;
+        worlds.par_iter_mut().for_each(|w| {
+            w.run_for(1.0).unwrap();
+            w.reset(0).unwrap();
+            w.run_for(3.0).unwrap();
+        })
+    });
+    for w in worlds {
+        assert_eq!(summary_json(&w.finish().unwrap()), want);
+    }
 }
 
 #[test]
