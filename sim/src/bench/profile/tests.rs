@@ -20,7 +20,7 @@ fn the_span_timer_times_system_spans_only() {
             std::thread::sleep(Duration::from_millis(1));
         }
         let _in = other.enter();
-        std::thread::sleep(Duration::from_millis(5));
+        std::thread::sleep(Duration::from_millis(50));
     });
     let t = times.lock().unwrap();
     // the check_conditions span was never created
@@ -28,7 +28,8 @@ fn the_span_timer_times_system_spans_only() {
     let (time, runs) = t.of("my::system_a");
     assert_eq!(runs, 3, "commands do not count as runs");
     assert!(time >= Duration::from_millis(7), "{time:?}");
-    assert!(time < Duration::from_millis(12), "{time:?}");
+    // the 50 ms of the other span are not counted (a loaded machine may stretch the 7 ms)
+    assert!(time < Duration::from_millis(50), "{time:?}");
     assert_eq!(t.of("my::other"), (Duration::ZERO, 0));
 }
 

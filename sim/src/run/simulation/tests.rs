@@ -639,7 +639,8 @@ fn a_given_kernel_pool_gives_the_same_run() {
         use rayon::prelude::*;
         worlds.par_iter_mut().for_each(|w| {
             w.run_for(1.0).unwrap();
-            w.reset(0).unwrap();
+            let seed = w.scenario().seed;
+            w.reset(seed).unwrap();
             w.run_for(3.0).unwrap();
         })
     });
