@@ -367,6 +367,37 @@ impl PySimulation {
         Self::build(py, b, Options::from_kwargs(options)?)
     }
 
+    /// A scenario built in code: nested dicts and lists with the scenario file's structure
+    /// (`{"name": "corridor", "duration": 60.0, "robots": [{"name": "r1", ...}]}`), checked
+    /// as a file is, so errors name the key. Relative paths start from `relative_to`. Takes
+    /// the options of `Simulation(...)`.
+    #[staticmethod]
+    #[pyo3(signature = (scenario, *, relative_to = None, **options))]
+    fn from_dict(
+        py: Python<'_>,
+        scenario: &Bound<'_, PyDict>,
+        relative_to: Option<PathBuf>,
+        options: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Self> {
+        let json: String = py
+            .import("json")?
+            .call_method1("dumps", (scenario,))?
+            .extract()?;
+        let table: toml::Table = serde_json::from_str(&json).map_err(|e| {
+            PyValueError::new_err(format!(
+                "scenario: expected strings, numbers, bools, lists and dicts (TOML has no \
+                 None): {e}"
+            ))
+        })?;
+        let text = toml::to_string(&table)
+            .map_err(|e| PyValueError::new_err(format!("scenario: not a TOML document: {e}")))?;
+        let mut b = Simulation::from_toml(&text, "<dict>");
+        if let Some(dir) = relative_to {
+            b = b.relative_to(dir);
+        }
+        Self::build(py, b, Options::from_kwargs(options)?)
+    }
+
     /// The scenario's name.
     #[getter]
     fn name(&self) -> &str {

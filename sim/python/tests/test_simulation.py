@@ -216,3 +216,29 @@ def test_the_gil_is_released_while_the_engine_steps():
     t.join()
     # with the GIL held through run_for, this thread could not count while it ran
     assert during[0] > 1000
+
+
+def test_a_scenario_built_in_code_runs_and_bad_keys_are_named():
+    corridor = {
+        "name": "corridor",
+        "duration": 2.0,
+        "walls": [{"from": [0.0, 0.0], "to": [20.0, 0.0]}, {"from": [0.0, 3.0], "to": [20.0, 3.0]}],
+        "robots": [
+            {
+                "name": "r1",
+                "start": [1.0, 1.5, 0.0],
+                "behaviour": {"type": "waypoints", "points": [[19.0, 1.5]], "speed": 0.8},
+                "sensors": {"laser": {"preset": "sick_lms100"}, "encoder": {}},
+                "localization": [{"type": "mcl", "init": "pose"}],
+            }
+        ],
+    }
+    s = sim.Simulation.from_dict(corridor, seed=2, threads=1)
+    summary = s.run()
+    assert summary["scenario"] == "corridor" and summary["seed"] == 2
+    assert summary["robots"][0]["distance_m"] > 1.0
+    corridor["robots"][0]["sensors"]["laser"]["frequency"] = 10.0
+    with pytest.raises(sim.ScenarioError, match="<dict>.*frequency"):
+        sim.Simulation.from_dict(corridor)
+    with pytest.raises(ValueError, match="TOML has no None"):
+        sim.Simulation.from_dict({"name": "x", "duration": None})

@@ -79,6 +79,16 @@ class Simulation:
         """Scenario TOML text, called ``label`` in error messages; relative paths start from
         ``relative_to`` (default: the current folder)."""
 
+    @staticmethod
+    def from_dict(
+        scenario: Mapping[str, Any],
+        *,
+        relative_to: str | PathLike[str] | None = None,
+        **options: Unpack[Options],
+    ) -> Simulation:
+        """A scenario built in code: nested dicts and lists with the file's structure, checked
+        as a file is (errors name the key)."""
+
     @property
     def name(self) -> str:
         """The scenario's name."""

@@ -1,7 +1,9 @@
-//! Scenarios built in code: [`Scenario::builder`] and [`RobotConfig::builder`].
+//! Scenarios built in code: [`Scenario::builder`] and
+//! [`RobotConfig::builder`](crate::scenario::RobotConfig::builder).
 //!
-//! The builders fill in the file model ([`ScenarioFile`], [`RobotFile`] and each feature's file
-//! tables) and [`ScenarioBuilder::build`] runs the resolver a TOML file goes through. So a value
+//! The builders fill in the file model ([`ScenarioFile`],
+//! [`RobotFile`](crate::scenario::RobotFile) and each feature's file tables) and
+//! [`ScenarioBuilder::build`] runs the resolver a TOML file goes through. So a value
 //! the builder is not given takes the file's default, and a bad value gets the file's error,
 //! naming the key (`robots[0].sensors.laser.max_range`); only the line is missing. The
 //! example is on [`Scenario::builder`].

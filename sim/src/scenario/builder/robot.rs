@@ -16,7 +16,7 @@ use crate::scenario::sonar::SonarFile;
 
 impl RobotConfig {
     /// A robot built in code, named `name`, starting at `start`: a pose `[x, y, yaw]` (or
-    /// `[x, y]`, or a [`Pose2`]) or the name of a place. Everything not given takes the
+    /// `[x, y]`, or a [`Pose2`](systems::core::Pose2)) or the name of a place. Everything not given takes the
     /// scenario file's default: a 0.25 m disc with a differential drive and no sensors, idle.
     pub fn builder(name: impl Into<String>, start: impl Into<PointOrPlace>) -> RobotBuilder {
         RobotBuilder {
@@ -45,7 +45,7 @@ impl RobotConfig {
 }
 
 /// Builds one robot of a scenario (a `[[robots]]` table); made by [`RobotConfig::builder`],
-/// given to [`ScenarioBuilder::robot`].
+/// given to [`ScenarioBuilder::robot`](super::ScenarioBuilder::robot).
 #[derive(Clone, Debug)]
 pub struct RobotBuilder {
     pub(super) file: RobotFile,
