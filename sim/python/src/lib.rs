@@ -26,5 +26,7 @@ fn _sim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robot::PyEstimate>()?;
     m.add_class::<controller::PyObservation>()?;
     m.add_function(wrap_pyfunction!(simulation::scenarios, m)?)?;
+    m.add_function(wrap_pyfunction!(simulation::assets_dir, m)?)?;
+    m.add_function(wrap_pyfunction!(simulation::use_bundled_assets, m)?)?;
     Ok(())
 }

@@ -150,12 +150,16 @@ impl<'py> Options<'py> {
                 b = b.set(&key, &text);
             }
         }
-        b = b.cache(if self.cache {
+        Ok(b.cache(self.map_cache()))
+    }
+
+    /// The on-disk cache of map structures, or none with `cache=False`.
+    pub fn map_cache(&self) -> systems::core::cache::MapCache {
+        if self.cache {
             sim::cache::from_env(false)
         } else {
             systems::core::cache::MapCache::disabled()
-        });
-        Ok(b)
+        }
     }
 
     /// Every option: the world's, the outputs and the controllers.
@@ -654,4 +658,17 @@ impl PySimulation {
 pub fn scenarios() -> PyResult<Vec<String>> {
     let all = sim::scenario::load::bundled_scenarios().map_err(engine_error)?;
     Ok(all.into_iter().map(|(n, _)| n).collect())
+}
+
+/// The folder the bundled scenarios, maps and roads are read from: `$SIM_ASSETS` when set,
+/// else the copy inside this package, else the repository the package was built from.
+#[pyfunction]
+pub fn assets_dir() -> std::path::PathBuf {
+    sim::scenario::load::assets_dir()
+}
+
+/// Called once by the package's `__init__`: its own copy of the assets.
+#[pyfunction]
+pub fn use_bundled_assets(dir: std::path::PathBuf) {
+    sim::scenario::load::use_bundled_assets(dir)
 }

@@ -249,12 +249,17 @@ impl PyVecSimulation {
         let pool =
             KernelPool::new(threads).map_err(|e| PyValueError::new_err(format!("threads: {e}")))?;
         let mut builders = Vec::with_capacity(num_worlds);
+        // one copy of the map's read-only structures for every world (and every reset)
+        let cache = crate::simulation::Options::from_kwargs(options)?
+            .map_cache()
+            .sharing();
         for i in 0..num_worlds as u64 {
             let opts = crate::simulation::Options::from_kwargs(options)?;
             let b = opts.apply_plain(Simulation::load(scenario))?;
             builders.push(
                 b.seed(seed.wrapping_add(i))
-                    .kernel_pool(KernelPool::inline()),
+                    .kernel_pool(KernelPool::inline())
+                    .cache(cache.clone()),
             );
         }
         let built: Vec<anyhow::Result<Simulation>> = py.detach(|| {

@@ -1,7 +1,11 @@
 """The scripting facade from Python: loading, stepping, reading, commanding, finishing."""
 
 import math
+import os
+import subprocess
+import sys
 import threading
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +17,25 @@ from conftest import verify_rrd
 def test_bundled_scenarios_are_listed():
     names = sim.scenarios()
     assert "hospital_patrol" in names and "maze_run" in names
+
+
+def test_the_installed_package_reads_its_own_copy_of_the_assets(tmp_path):
+    own = Path(sim.__file__).parent / "assets"
+    if "SIM_ASSETS" not in os.environ:
+        assert sim.assets_dir() == own
+    # a real folder in the installed package, not a link back into the repository
+    assert own.is_dir() and not own.is_symlink()
+    assert sorted(p.stem for p in (own / "scenarios").glob("*.toml")) == sim.scenarios()
+    s = sim.Simulation("hospital_nav", duration=1.0, threads=1)
+    s.run_for(0.5)
+    assert s.ticks == 10
+    # $SIM_ASSETS still wins, and a folder without scenarios is a clear error
+    code = "import sim; print(sim.assets_dir()); sim.Simulation('hospital_nav')"
+    env = dict(os.environ, SIM_ASSETS=str(tmp_path))
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert p.returncode != 0
+    assert p.stdout.strip() == str(tmp_path)
+    assert "hospital_nav" in p.stderr and str(tmp_path) in p.stderr, p.stderr
 
 
 def test_reads_every_robot_between_ticks():

@@ -31,11 +31,24 @@ pub fn parse_scenario(
     super::resolve::resolve(text, file_label, base_dir, default_name)
 }
 
-/// The folder of the bundled assets: `$SIM_ASSETS` or the repository's `assets/`
-/// ([`systems::core::source`]).
+/// A copy of the assets that a package carries with it ([`use_bundled_assets`]).
+static PACKAGED_ASSETS: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+
+/// Makes `dir` the assets' folder wherever `$SIM_ASSETS` does not name one: for a package that
+/// ships its own copy (the Python wheel), so it keeps working when the repository it was built
+/// from moves or is gone. The first call wins.
+pub fn use_bundled_assets(dir: PathBuf) {
+    let _ = PACKAGED_ASSETS.set(dir);
+}
+
+/// The folder of the bundled assets: `$SIM_ASSETS`, else a package's own copy
+/// ([`use_bundled_assets`]), else the repository's `assets/` ([`systems::core::source`]).
 pub fn assets_dir() -> PathBuf {
-    match std::env::var_os("SIM_ASSETS") {
-        Some(p) => PathBuf::from(p),
+    if let Some(p) = std::env::var_os("SIM_ASSETS") {
+        return PathBuf::from(p);
+    }
+    match PACKAGED_ASSETS.get() {
+        Some(p) => p.clone(),
         None => systems::core::source::source_path("assets"),
     }
 }

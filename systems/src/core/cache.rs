@@ -14,10 +14,16 @@
 //! written to a temporary file and renamed into place, so a reader sees a whole entry or none;
 //! one that is truncated, corrupt or not for its key is rebuilt and replaced. The cache never
 //! fails a build: a folder that cannot be read or written only costs the time of building.
+//!
+//! A cache can also share ([`MapCache::sharing`]): worlds built through it hold one copy of a
+//! read-only structure ([`MapCache::get_or_build_shared`]) instead of one each, so many worlds of
+//! one map side by side keep a single ray map in the processor's caches.
 
+use std::any::Any;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// First bytes of every entry (and of every key's hash input).
 const MAGIC: &[u8; 8] = b"SIMCACH1";
@@ -119,11 +125,16 @@ struct Counters {
     write_failures: AtomicU64,
 }
 
-/// The cache: a folder of entries, or none (every structure is built).
+/// Structures handed out by a sharing cache, by key digest.
+type Shared = Mutex<HashMap<[u8; 32], Arc<dyn Any + Send + Sync>>>;
+
+/// The cache: a folder of entries, or none (every structure is built); with or without a copy in
+/// memory shared by every world built through it and its clones ([`MapCache::sharing`]).
 #[derive(Clone, Default)]
 pub struct MapCache {
     dir: Option<Arc<Path>>,
     counters: Arc<Counters>,
+    shared: Option<Arc<Shared>>,
 }
 
 impl std::fmt::Debug for MapCache {
@@ -149,7 +160,45 @@ impl MapCache {
         MapCache {
             dir: Some(Arc::from(dir.into())),
             counters: Arc::default(),
+            shared: None,
         }
+    }
+
+    /// This cache, keeping in memory each structure it hands out through
+    /// [`MapCache::get_or_build_shared`] and handing the same copy to every later world built
+    /// through it or its clones (a vectorized simulation's worlds). A world that edits its copy
+    /// (a door) edits a copy of its own.
+    pub fn sharing(self) -> Self {
+        MapCache {
+            shared: Some(Arc::default()),
+            ..self
+        }
+    }
+
+    /// [`MapCache::get_or_build`] for a read-only structure: with [`MapCache::sharing`], the
+    /// copy an earlier world of this cache got, if any; else a copy of its own.
+    pub fn get_or_build_shared<T: Cached + Send + Sync + 'static>(
+        &self,
+        key: &CacheKey,
+        build: impl FnOnce() -> T,
+    ) -> Arc<T> {
+        let Some(shared) = &self.shared else {
+            return Arc::new(self.get_or_build(key, build));
+        };
+        let digest = key.digest();
+        let held = shared
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .get(&digest)
+            .cloned();
+        if let Some(v) = held.and_then(|v| v.downcast::<T>().ok()) {
+            return v;
+        }
+        // built outside the lock (worlds are built in parallel); the first one stored is kept
+        let built = Arc::new(self.get_or_build(key, build));
+        let mut map = shared.lock().unwrap_or_else(|e| e.into_inner());
+        let kept = map.entry(digest).or_insert_with(|| built.clone()).clone();
+        kept.downcast::<T>().unwrap_or(built)
     }
 
     /// The folder, if the cache is on.

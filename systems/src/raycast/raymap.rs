@@ -62,6 +62,16 @@ impl RayMap {
         cache.get_or_build(&key, || RayMap::from_grid(grid))
     }
 
+    /// [`RayMap::from_grid_cached`], the copy other worlds of a sharing cache hold if any
+    /// ([`MapCache::get_or_build_shared`]).
+    pub fn from_grid_shared(
+        grid: &crate::world::OccupancyGrid,
+        cache: &MapCache,
+    ) -> std::sync::Arc<Self> {
+        let key = grid.add_to_key(CacheKey::new::<RayMap>());
+        cache.get_or_build_shared(&key, || RayMap::from_grid(grid))
+    }
+
     pub fn new(
         width: usize,
         height: usize,

@@ -6,6 +6,7 @@ use super::raymap::RayMap;
 use crate::core::cache::MapCache;
 use crate::world::grid::{Cell, OccupancyGrid};
 use bevy_ecs::prelude::Resource;
+use std::sync::Arc;
 
 /// Side of a physics collider tile, in cells (64 cells = 3.2 m at 5 cm).
 pub const COLLIDER_TILE: usize = 64;
@@ -13,7 +14,8 @@ pub const COLLIDER_TILE: usize = 64;
 #[derive(Resource)]
 pub struct StaticWorld {
     grid: OccupancyGrid,
-    rays: RayMap,
+    /// Shared by the worlds of a sharing cache until one of them edits it.
+    rays: Arc<RayMap>,
     dirty_tiles: Vec<(usize, usize)>,
     /// Incremented on every edit (planners and recorders can watch it).
     pub version: u64,
@@ -24,9 +26,10 @@ impl StaticWorld {
         Self::new_cached(grid, &MapCache::disabled())
     }
 
-    /// [`StaticWorld::new`] with the ray map read from `cache` when it holds this grid's.
+    /// [`StaticWorld::new`] with the ray map read from `cache` when it holds this grid's (the
+    /// copy other worlds hold, when it shares).
     pub fn new_cached(grid: OccupancyGrid, cache: &MapCache) -> Self {
-        let rays = RayMap::from_grid_cached(&grid, cache);
+        let rays = RayMap::from_grid_shared(&grid, cache);
         StaticWorld {
             grid,
             rays,
@@ -69,7 +72,7 @@ impl StaticWorld {
             }
         }
         if !ray_edits.is_empty() {
-            self.rays.set_cells(&ray_edits);
+            Arc::make_mut(&mut self.rays).set_cells(&ray_edits);
             self.version += 1;
         }
     }

@@ -15,6 +15,8 @@ writes. The GIL is released while the engine steps.
 The guide is ``sim/docs/python.md`` in the repository.
 """
 
+from pathlib import Path as _Path
+
 from ._sim import (
     Estimate,
     Observation,
@@ -25,8 +27,15 @@ from ._sim import (
     Simulation,
     VecSimulation,
     __version__,
+    assets_dir,
     scenarios,
+    use_bundled_assets as _use_bundled_assets,
 )
+
+# The wheel carries the repository's assets (scenarios, maps, roads): an installed package
+# reads its own copy, and keeps working when the clone it was built from moves or is gone.
+if (_Path(__file__).parent / "assets" / "scenarios").is_dir():
+    _use_bundled_assets(str(_Path(__file__).parent / "assets"))
 
 __all__ = [
     "Estimate",
@@ -38,5 +47,6 @@ __all__ = [
     "Simulation",
     "VecSimulation",
     "__version__",
+    "assets_dir",
     "scenarios",
 ]

@@ -1,5 +1,6 @@
 """Type stubs of the native module (``sim._sim``); the names are re-exported by ``sim``."""
 
+import pathlib
 from collections.abc import Callable, Mapping
 from os import PathLike
 from typing import Any, TypedDict, Unpack
@@ -48,6 +49,13 @@ class ScenarioError(SimError):
 
 def scenarios() -> list[str]:
     """The bundled scenarios' names."""
+
+def assets_dir() -> pathlib.Path:
+    """The folder the bundled scenarios, maps and roads are read from: ``$SIM_ASSETS`` when
+    set, else the copy inside this package, else the repository the package was built from."""
+
+def use_bundled_assets(dir: str) -> None:
+    """Called once by the package itself: its own copy of the assets."""
 
 class Simulation:
     """A running simulation of one scenario: step it, read its robots, command them, and

@@ -255,3 +255,48 @@ fn the_road_raster_from_the_cache_is_the_built_one() {
     SurfaceRaster::build_cached(&wider, res, margin, &cache);
     assert_eq!(cache.stats().misses, 2);
 }
+
+/// A sharing cache hands every world the one copy the first got (built once, with or without a
+/// folder); a plain cache hands each its own; and a world that closes a door edits a copy of its
+/// own, leaving the others' rays as they were.
+#[test]
+fn worlds_of_a_sharing_cache_hold_one_ray_map_until_one_edits_it() {
+    use crate::raycast::StaticWorld;
+    let dir = tempfile::tempdir().unwrap();
+    for cache in [MapCache::disabled(), MapCache::in_dir(dir.path())] {
+        let sharing = cache.clone().sharing();
+        let first = sharing.get_or_build_shared(&CacheKey::new::<Blob>().u64(1), || blob(1));
+        let mut builds = 0;
+        let second = sharing.get_or_build_shared(&CacheKey::new::<Blob>().u64(1), || {
+            builds += 1;
+            blob(1)
+        });
+        assert_eq!(builds, 0);
+        assert!(Arc::ptr_eq(&first, &second));
+        // a clone shares too; another key is another structure
+        let other = sharing
+            .clone()
+            .get_or_build_shared(&CacheKey::new::<Blob>().u64(2), || blob(2));
+        same(&other, &blob(2));
+        let plain = cache.get_or_build_shared(&CacheKey::new::<Blob>().u64(1), || blob(1));
+        assert!(!Arc::ptr_eq(&first, &plain));
+        same(&first, &plain);
+    }
+
+    let sharing = MapCache::disabled().sharing();
+    let mut a = StaticWorld::new_cached(hospital(), &sharing);
+    let b = StaticWorld::new_cached(hospital(), &sharing);
+    assert!(std::ptr::eq(a.rays(), b.rays()));
+    // along the main corridor, east: a door-like wall 1 m ahead in world a only
+    let (p, angle) = ([32.0f32, 16.0f32], 0.0f32);
+    let before = b.rays().cast(p, angle, 30.0);
+    assert!(before > 5.0, "{before}");
+    a.set_region(32.9, 15.0, 33.1, 17.0, Cell::Occupied);
+    assert!(!std::ptr::eq(a.rays(), b.rays()));
+    assert!(a.rays().cast(p, angle, 30.0) < 1.0);
+    assert_eq!(b.rays().cast(p, angle, 30.0).to_bits(), before.to_bits());
+    assert_eq!(
+        to_bytes(b.rays()),
+        to_bytes(&RayMap::from_grid(&hospital()))
+    );
+}
