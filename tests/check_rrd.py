@@ -1,6 +1,7 @@
 """Prints the entity paths and timelines of an .rrd as JSON, read with the Rerun SDK (0.36.3),
 and, per entity holding `Scalars`, the number of values, their minimum, maximum and median, and
-the first and last `sim_time` (seconds) they were logged at."""
+the first and last `sim_time` (seconds) they were logged at; per entity holding `TextLog`s, its
+lines as `[sim_time, level, text]` in time order."""
 
 import json
 import sys
@@ -15,9 +16,22 @@ def main() -> None:
     timelines = sorted({c.name for c in schema.index_columns()})
     values: dict[str, list[float]] = {}
     times: dict[str, list[float]] = {}
+    texts: dict[str, list[list]] = {}
     for chunk in store.stream():
         batch = chunk.to_record_batch()
         names = batch.schema.names
+        if "TextLog:text" in names and "sim_time" in names:
+            lines = batch.column(names.index("TextLog:text")).to_pylist()
+            levels = (
+                batch.column(names.index("TextLog:level")).to_pylist()
+                if "TextLog:level" in names
+                else [None] * len(lines)
+            )
+            stamps = batch.column(names.index("sim_time")).cast("int64").to_pylist()
+            for line, level, t in zip(lines, levels, stamps):
+                for k, text in enumerate(line or []):
+                    lv = (level or [None])[min(k, len(level or [None]) - 1)]
+                    texts.setdefault(chunk.entity_path, []).append([t * 1e-9, lv, text])
         if "Scalars:scalars" not in names or "sim_time" not in names:
             continue
         scalars = batch.column(names.index("Scalars:scalars")).to_pylist()
@@ -38,7 +52,18 @@ def main() -> None:
             "first_t": min(times[path]),
             "last_t": max(times[path]),
         }
-    print(json.dumps({"entity_paths": paths, "timelines": timelines, "scalars": scalars_out}))
+    for lines in texts.values():
+        lines.sort(key=lambda x: x[0])
+    print(
+        json.dumps(
+            {
+                "entity_paths": paths,
+                "timelines": timelines,
+                "scalars": scalars_out,
+                "text_logs": texts,
+            }
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -131,3 +131,99 @@ fn a_panicking_controller_leaves_a_finished_recording() {
         assert!(text.contains("robots/r1"), "{text}");
     }
 }
+
+/// The run's story is in text-log lines at the times things happened: every scenario event and
+/// program command as it fires in `events` (a robot's lines led by its name), and a navigating
+/// robot's collisions, with what it hit and where, in `robots/<name>/collisions`: the lines of
+/// the run's own event log, at its times.
+#[test]
+fn events_and_collisions_are_text_log_lines_at_their_times() {
+    use sim::run::{Command, Simulation};
+    use sim::scenario::SensorName;
+    let Some(rerun) = test_tool(TestTool::Rerun) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("delivery.rrd");
+    let mut s = Simulation::load("hospital_delivery")
+        .duration(6.0)
+        .threads(2)
+        .rrd(&path)
+        .build()
+        .unwrap();
+    let fault = |active| Command::SensorFault {
+        sensor: SensorName::Laser,
+        active,
+    };
+    s.run_for(1.0).unwrap();
+    s.command("r1", fault(true)).unwrap();
+    s.set_door("fire_door_w", false).unwrap();
+    s.run_for(1.0).unwrap();
+    s.command("r1", fault(false)).unwrap();
+    // r2 dropped onto r1: a collision between two navigating robots
+    let p = s.robot("r1").unwrap().pose();
+    let onto = systems::core::Pose2::new(p.x + 0.3, p.y, p.theta);
+    s.command("r2", Command::Teleport(onto)).unwrap();
+    s.run_for(1.0).unwrap();
+    let robots: Vec<String> = s.robots().iter().map(|r| r.name().to_string()).collect();
+    let done = s.finish().unwrap();
+
+    let v = check_rrd_with(&rerun, &path);
+    let lines = |entity: &str| -> Vec<(f64, String, String)> {
+        v["text_logs"][entity]
+            .as_array()
+            .map(|a| {
+                a.iter()
+                    .map(|l| {
+                        (
+                            l[0].as_f64().unwrap(),
+                            l[1].as_str().unwrap_or("").to_string(),
+                            l[2].as_str().unwrap().to_string(),
+                        )
+                    })
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let events = lines("/events");
+    let texts: Vec<&str> = events.iter().map(|(_, _, t)| t.as_str()).collect();
+    for want in [
+        "r1: laser fault on",
+        "door fire_door_w closed",
+        "r1: laser fault off",
+    ] {
+        assert!(texts.contains(&want), "{want} not in {texts:?}");
+    }
+    assert!(
+        texts.iter().any(|t| t.starts_with("r2: teleported")),
+        "{texts:?}"
+    );
+    // each line is one of the run's log, at its time
+    let in_log = |t: f64, robot: &str, text: &str| {
+        done.log
+            .iter()
+            .any(|(lt, r, l)| (lt - t).abs() < 1e-6 && r == robot && l == text)
+    };
+    for (t, level, line) in &events {
+        let (robot, text) = match line.split_once(": ") {
+            Some((r, rest)) if robots.iter().any(|n| n == r) => (r, rest),
+            _ => ("", line.as_str()),
+        };
+        assert!(in_log(*t, robot, text), "{t} {line} not in {:?}", done.log);
+        assert_eq!(level, "INFO");
+    }
+    let collisions: Vec<_> = done
+        .log
+        .iter()
+        .filter(|(_, _, l)| l.starts_with("collision with"))
+        .collect();
+    assert!(!collisions.is_empty(), "{:?}", done.log);
+    for (t, robot, text) in collisions {
+        let got = lines(&format!("/robots/{robot}/collisions"));
+        assert!(
+            got.iter()
+                .any(|(gt, lv, l)| (gt - t).abs() < 1e-6 && lv == "WARN" && l == text),
+            "{t} {robot} {text} not in {got:?}"
+        );
+    }
+}

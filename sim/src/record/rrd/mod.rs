@@ -23,11 +23,14 @@
 //!   truth; the localizers never do.
 //!
 //! - `people/<name>`: each walking person as a disc of its radius (a point with that radius,
-//!   labelled with its name) at the pose rate, and `people/<name>/trail`: its last few metres.
+//!   labelled with its name) at the pose rate, and `people/<name>/trail`: its last few metres;
+//! - `events` and `robots/<name>/collisions`: the run's events as text-log lines
+//!   ([`events`]).
 //!
 //! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
 
 pub mod belief;
+pub mod events;
 pub mod log_slam;
 pub mod navigation;
 pub mod outdoor;

@@ -2,6 +2,7 @@
 //! and their systems chained in the Record set.
 
 use super::RrdRecorder;
+use super::events::record_events;
 use super::navigation::record_navigation;
 use super::outdoor::{OutdoorRecording, record_outdoor};
 use super::record_rrd;
@@ -36,9 +37,15 @@ impl SimPlugin for RrdPlugin {
         world.insert_resource(rec);
         world.insert_resource(slam);
         world.insert_resource(outdoor);
-        // all four write the recorder
+        // all five write the recorder
         schedule.add_systems(
-            (record_rrd, record_navigation, record_slam, record_outdoor)
+            (
+                record_rrd,
+                record_navigation,
+                record_slam,
+                record_outdoor,
+                record_events,
+            )
                 .chain()
                 .in_set(SimSet::Record),
         );
