@@ -14,7 +14,7 @@
 //! follows a few seconds of other messages); readers order them by their log time.
 
 use super::rrd::RrdRecorder;
-use super::rrd::outdoor::record_outdoor;
+use super::rrd::events::record_events;
 use bevy_ecs::prelude::*;
 use std::cell::Cell;
 use std::collections::VecDeque;
@@ -216,7 +216,7 @@ impl SimPlugin for FramesPlugin {
             // recorders (all write the recorder)
             let images = record_frames_rrd
                 .in_set(SimSet::Record)
-                .after(record_outdoor);
+                .after(record_events);
             schedule.add_systems((collect, images).chain());
         } else {
             schedule.add_systems(collect);
