@@ -67,9 +67,9 @@ impl ReplayRecorder {
         (stamp, odom, truth, mount): (f64, &Pose2, Option<Pose2>, &Pose2),
     ) {
         let t = stamp - self.t0;
-        self.odometry.push(odom);
+        self.odometry.push(odom, t);
         if let Some(p) = truth {
-            self.truth.push(&p);
+            self.truth.push(&p, t);
         }
         self.rec.set_duration_secs("sim_time", t);
         if self.scan_at.is_none_or(|a| t - a >= 1.0 / SCAN_RATE - 1e-9)
@@ -92,9 +92,9 @@ impl ReplayRecorder {
             ("odometry", &self.odometry, grey),
             ("truth", &self.truth, rerun::Color::from_rgb(31, 119, 180)),
         ] {
-            let strip = path.strip();
-            if strip.len() >= 2 {
-                let strip = rerun::LineStrips3D::new([strip]).with_colors([colour]);
+            let strips = path.strips();
+            if strips.iter().any(|s| s.len() >= 2) {
+                let strip = rerun::LineStrips3D::new(strips).with_colors([colour]);
                 let res = self
                     .rec
                     .log(format!("robots/{}/{leaf}", self.robot), &strip);

@@ -331,7 +331,7 @@ impl RrdRecorder {
             }
         }
         for e in &l.fresh {
-            self.tracks[robot][k].path.push(&e.estimate.pose);
+            self.tracks[robot][k].path.push(&e.estimate.pose, e.stamp);
         }
         if let Some(e) = l.fresh.last() {
             self.rec.set_duration_secs("sim_time", e.stamp);
@@ -350,8 +350,8 @@ impl RrdRecorder {
         }
         self.rec.set_duration_secs("sim_time", now);
         if paths_due && !self.tracks[robot][k].path.is_empty() {
-            let strip = self.tracks[robot][k].path.strip();
-            rows::strips(&mut self.rec, &est_path, [strip], c);
+            let strips = self.tracks[robot][k].path.strips();
+            rows::strips(&mut self.rec, &est_path, strips, c);
         }
     }
 
@@ -431,9 +431,9 @@ pub fn record_rrd(
         if !(poses_due || scans_due || paths_due) {
             continue;
         }
-        r.truth_paths[i].push(&truth.pose);
+        r.truth_paths[i].push(&truth.pose, now);
         if let Some(o) = odom {
-            r.odom_paths[i].push(&o.pose);
+            r.odom_paths[i].push(&o.pose, now);
         }
         let c = colour(idx.0);
         let grey = rerun::Color::from_rgb(150, 150, 150);
@@ -453,11 +453,11 @@ pub fn record_rrd(
             }
         }
         if paths_due {
-            let strip = r.truth_paths[i].strip();
-            rows::strips(&mut r.rec, &format!("{base}/truth"), [strip], c);
+            let strips = r.truth_paths[i].strips();
+            rows::strips(&mut r.rec, &format!("{base}/truth"), strips, c);
             if odom.is_some() {
-                let strip = r.odom_paths[i].strip();
-                rows::strips(&mut r.rec, &format!("{base}/odometry"), [strip], grey);
+                let strips = r.odom_paths[i].strips();
+                rows::strips(&mut r.rec, &format!("{base}/odometry"), strips, grey);
             }
         }
         if scans_due

@@ -4,6 +4,10 @@
 //! straight line from that kept point to the newest one (a streaming form of the
 //! Reumann–Witkam / Douglas–Peucker simplification). A 190 m park route keeps a few hundred
 //! points instead of thousands; nothing drawn moves by more than a centimetre.
+//!
+//! A path breaks where it jumps: a point farther from the previous one than [`JUMP_BASE`] plus
+//! [`JUMP_SPEED`] times the time between them (a localizer's estimate snapping to another
+//! place, a teleported robot) starts a new strip, so no line is drawn across the building.
 
 use systems::core::Pose2;
 
@@ -13,6 +17,10 @@ pub const TOLERANCE: f32 = 0.01;
 const SPACING: f32 = 0.05;
 /// At most this many points wait for the next bend (bounds the work per point).
 const MAX_PENDING: usize = 256;
+/// A step longer than this (m) plus [`JUMP_SPEED`] times its duration breaks the path.
+pub const JUMP_BASE: f32 = 1.0;
+/// Faster than any robot drives (m/s): a step beyond it is a jump, not a drive.
+pub const JUMP_SPEED: f32 = 5.0;
 
 #[derive(Clone, Debug, Default)]
 pub struct PathTrace {
@@ -20,6 +28,10 @@ pub struct PathTrace {
     /// Points since the last kept one, the newest last (all within TOLERANCE of the line from
     /// the last kept point to the newest).
     pending: Vec<[f32; 2]>,
+    /// Indices into `kept` where a strip starts after a jump.
+    breaks: Vec<usize>,
+    /// Time of the newest point.
+    last_t: f64,
 }
 
 /// Distance of `p` from the segment a–b.
@@ -36,15 +48,29 @@ fn segment_distance(p: [f32; 2], a: [f32; 2], b: [f32; 2]) -> f32 {
 }
 
 impl PathTrace {
-    /// Adds the robot's position.
-    pub fn push(&mut self, pose: &Pose2) {
+    /// Adds the robot's position at simulated time `t` (s).
+    pub fn push(&mut self, pose: &Pose2, t: f64) {
         let q = [pose.x as f32, pose.y as f32];
         let Some(&anchor) = self.kept.last() else {
             self.kept.push(q);
+            self.last_t = t;
             return;
         };
         let last = self.pending.last().copied().unwrap_or(anchor);
-        if (q[0] - last[0]).hypot(q[1] - last[1]) < SPACING {
+        let step = (q[0] - last[0]).hypot(q[1] - last[1]);
+        let dt = (t - self.last_t).max(0.0) as f32;
+        self.last_t = t;
+        if step > JUMP_BASE + JUMP_SPEED * dt {
+            // the newest point before the jump ends its strip; the new one starts the next
+            if let Some(end) = self.pending.pop() {
+                self.kept.push(end);
+                self.pending.clear();
+            }
+            self.breaks.push(self.kept.len());
+            self.kept.push(q);
+            return;
+        }
+        if step < SPACING {
             return;
         }
         let straight = self.pending.len() < MAX_PENDING
@@ -64,13 +90,25 @@ impl PathTrace {
         self.kept.is_empty()
     }
 
-    /// The polyline to draw: the kept points and the newest one.
-    pub fn strip(&self) -> Vec<[f32; 3]> {
-        self.kept
-            .iter()
-            .chain(self.pending.last())
-            .map(|p| [p[0], p[1], 0.0])
-            .collect()
+    /// The polylines to draw, one per stretch between jumps: the kept points and the newest
+    /// one.
+    pub fn strips(&self) -> Vec<Vec<[f32; 3]>> {
+        let mut out: Vec<Vec<[f32; 3]>> = Vec::with_capacity(self.breaks.len() + 1);
+        let mut from = 0;
+        for &b in self.breaks.iter().chain([&self.kept.len()]) {
+            out.push(
+                self.kept[from..b]
+                    .iter()
+                    .map(|p| [p[0], p[1], 0.0])
+                    .collect(),
+            );
+            from = b;
+        }
+        if let (Some(newest), Some(last)) = (self.pending.last(), out.last_mut()) {
+            last.push([newest[0], newest[1], 0.0]);
+        }
+        out.retain(|s| !s.is_empty());
+        out
     }
 }
 
@@ -78,12 +116,20 @@ impl PathTrace {
 mod tests {
     use super::*;
 
+    /// A trace of `points` pushed 0.1 s apart.
     fn trace(points: &[[f64; 2]]) -> PathTrace {
         let mut t = PathTrace::default();
-        for p in points {
-            t.push(&Pose2::new(p[0], p[1], 0.0));
+        for (k, p) in points.iter().enumerate() {
+            t.push(&Pose2::new(p[0], p[1], 0.0), k as f64 * 0.1);
         }
         t
+    }
+
+    /// The one strip of a trace without jumps.
+    fn strip(t: &PathTrace) -> Vec<[f32; 3]> {
+        let mut s = t.strips();
+        assert!(s.len() <= 1, "{s:?}");
+        s.pop().unwrap_or_default()
     }
 
     /// Largest distance of any input point from the drawn polyline.
@@ -103,13 +149,13 @@ mod tests {
     #[test]
     fn a_straight_drive_is_two_points() {
         let pts: Vec<[f64; 2]> = (0..200).map(|k| [k as f64 * 0.1, 2.0]).collect();
-        let s = trace(&pts).strip();
+        let s = strip(&trace(&pts));
         assert_eq!(s.len(), 2);
         assert_eq!(s[0], [0.0, 2.0, 0.0]);
         assert!((s[1][0] - 19.9).abs() < 1e-4);
         // a long one gets a vertex every MAX_PENDING points (bounded work per point)
         let pts: Vec<[f64; 2]> = (0..1000).map(|k| [k as f64 * 0.1, 2.0]).collect();
-        let s = trace(&pts).strip();
+        let s = strip(&trace(&pts));
         assert_eq!(s.len(), 2 + 999 / MAX_PENDING);
         assert!(deviation(&pts, &s) < 1e-4);
     }
@@ -124,7 +170,7 @@ mod tests {
                 [5.0 * a.cos(), 5.0 * a.sin()]
             })
             .collect();
-        let s = trace(&pts).strip();
+        let s = strip(&trace(&pts));
         // chords with a 1 cm sagitta on a 5 m radius are about 0.63 m long: ~50 of them
         assert!(s.len() < 80, "{} points", s.len());
         assert!(s.len() > 30, "{} points", s.len());
@@ -144,7 +190,7 @@ mod tests {
         for k in 1..=20 {
             pts.push([2.0, k as f64 * 0.1]);
         }
-        let s = trace(&pts).strip();
+        let s = strip(&trace(&pts));
         assert_eq!(s.len(), 3, "{s:?}");
         assert!((s[1][0] - 2.0).abs() < 1e-6 && s[1][1].abs() < 1e-6);
         assert!(deviation(&pts, &s) <= TOLERANCE);
@@ -152,8 +198,43 @@ mod tests {
 
     #[test]
     fn an_empty_trace_draws_nothing_and_one_point_draws_itself() {
-        assert!(PathTrace::default().strip().is_empty());
+        assert!(PathTrace::default().strips().is_empty());
         let t = trace(&[[1.0, 2.0]]);
-        assert_eq!(t.strip(), vec![[1.0, 2.0, 0.0]]);
+        assert_eq!(t.strips(), vec![vec![[1.0, 2.0, 0.0]]]);
+    }
+
+    /// A localizer snapping 12 m away (global localization converging, or a kidnapping)
+    /// starts a new strip: no segment is drawn across the jump, and each side keeps its own
+    /// simplified line.
+    #[test]
+    fn a_jump_breaks_the_path_and_no_segment_crosses_it() {
+        let mut pts: Vec<[f64; 2]> = (0..30).map(|k| [k as f64 * 0.05, 0.0]).collect();
+        pts.extend((0..30).map(|k| [k as f64 * 0.05, 12.0]));
+        let t = trace(&pts);
+        let s = t.strips();
+        assert_eq!(s.len(), 2, "{s:?}");
+        assert!(s[0].iter().all(|p| p[1] == 0.0) && s[1].iter().all(|p| p[1] == 12.0));
+        assert!(deviation(&pts[..30], &s[0]) <= TOLERANCE);
+        assert!(deviation(&pts[30..], &s[1]) <= TOLERANCE);
+        // a single point between two jumps is a strip of one point (drawn as nothing)
+        let t = trace(&[[0.0, 0.0], [0.05, 0.0], [9.0, 9.0], [0.1, 0.0], [0.15, 0.0]]);
+        let s = t.strips();
+        assert_eq!(s.len(), 3, "{s:?}");
+        assert_eq!(s[1], vec![[9.0, 9.0, 0.0]]);
+    }
+
+    /// A robot driving fast but recorded rarely (3 m/s, a point a second) is one path; the same
+    /// distance in a tenth of a second is a jump.
+    #[test]
+    fn a_fast_drive_recorded_rarely_is_not_a_jump() {
+        let mut t = PathTrace::default();
+        for k in 0..20 {
+            t.push(&Pose2::new(k as f64 * 3.0, 0.0, 0.0), k as f64);
+        }
+        assert_eq!(t.strips().len(), 1);
+        let mut t = PathTrace::default();
+        t.push(&Pose2::new(0.0, 0.0, 0.0), 0.0);
+        t.push(&Pose2::new(3.0, 0.0, 0.0), 0.1);
+        assert_eq!(t.strips().len(), 2);
     }
 }
