@@ -1,7 +1,8 @@
 """Prints the entity paths and timelines of an .rrd as JSON, read with the Rerun SDK (0.36.3),
 and, per entity holding `Scalars`, the number of values, their minimum, maximum and median, and
 the first and last `sim_time` (seconds) they were logged at; per entity holding `TextLog`s, its
-lines as `[sim_time, level, text]` in time order."""
+lines as `[sim_time, level, text]` in time order; per entity styled with `SeriesLines`, its
+series names."""
 
 import json
 import sys
@@ -17,9 +18,14 @@ def main() -> None:
     values: dict[str, list[float]] = {}
     times: dict[str, list[float]] = {}
     texts: dict[str, list[list]] = {}
+    series_names: dict[str, list[str]] = {}
     for chunk in store.stream():
         batch = chunk.to_record_batch()
         names = batch.schema.names
+        if "SeriesLines:names" in names:
+            for row in batch.column(names.index("SeriesLines:names")).to_pylist():
+                if row:
+                    series_names[chunk.entity_path] = row
         if "TextLog:text" in names and "sim_time" in names:
             lines = batch.column(names.index("TextLog:text")).to_pylist()
             levels = (
@@ -61,6 +67,7 @@ def main() -> None:
                 "timelines": timelines,
                 "scalars": scalars_out,
                 "text_logs": texts,
+                "series_names": series_names,
             }
         )
     )

@@ -58,7 +58,7 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
             want.push(format!("{base}/estimate/{}", l.name));
             want.push(format!("{base}/estimate/{}/covariance", l.name));
             want.push(format!("{base}/error/{}", l.name));
-            want.push(format!("{base}/error/{}/heading", l.name));
+            want.push(format!("{base}/heading_error/{}", l.name));
             // DE odometry keeps no population
             if !matches!(l.kind, LocalizerKind::DeOdometry(_)) {
                 want.push(format!("{base}/particles/{}", l.name));
@@ -75,7 +75,7 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
     for r in &s.robots {
         for l in &r.localizers {
             let pos = &scalars[format!("/robots/{}/error/{}", r.name, l.name)];
-            let head = &scalars[format!("/robots/{}/error/{}/heading", r.name, l.name)];
+            let head = &scalars[format!("/robots/{}/heading_error/{}", r.name, l.name)];
             let f = |x: &serde_json::Value, k: &str| x[k].as_f64().unwrap_or(f64::NAN);
             assert!(f(pos, "count") >= 3.0, "{} {}: {pos}", r.name, l.name);
             assert_eq!(pos["count"], head["count"], "{} {}", r.name, l.name);
@@ -94,6 +94,26 @@ fn rrd_opens_in_rerun_and_has_the_entity_paths() {
             }
         }
     }
+    // every series is named after its robot and localizer, and no position series holds radians
+    for r in &s.robots {
+        for l in &r.localizers {
+            let want = format!("{} {}", r.name, l.name);
+            for family in ["error", "heading_error"] {
+                let path = format!("/robots/{}/{family}/{}", r.name, l.name);
+                assert_eq!(
+                    v["series_names"][&path],
+                    serde_json::json!([want]),
+                    "{path}"
+                );
+            }
+        }
+    }
+    assert!(
+        !paths
+            .iter()
+            .any(|p| p.contains("/error/") && p.ends_with("/heading")),
+        "{paths:?}"
+    );
     let timelines = v["timelines"].as_array().unwrap();
     assert!(timelines.iter().any(|t| t == "sim_time"), "{timelines:?}");
 }

@@ -18,9 +18,11 @@
 //!   most `particle_points` points (default 1000; 0 turns particles off), so a 100 000-particle
 //!   filter costs the same ~16 kB per set as a small one;
 //! - `robots/<name>/error/<localizer>`: position error (m) of every published estimate against
-//!   ground truth at its timestamp (the pairs the summary's metrics use), as a scalar series;
-//!   `…/error/<localizer>/heading`: the absolute heading error (rad). The recorder reads ground
-//!   truth; the localizers never do.
+//!   ground truth at its timestamp (the pairs the summary's metrics use), as a scalar series
+//!   named `<name> <localizer>`; `robots/<name>/heading_error/<localizer>`: the absolute heading
+//!   error (rad), in a subtree of its own so metres and radians never share a plot. The
+//!   recorder reads ground truth; the localizers never do. A robot keeps one colour across its
+//!   entities, its localizers as shades of it.
 //!
 //! - `people/<name>`: each walking person as a disc of its radius (a point with that radius,
 //!   labelled with its name) at the pose rate, and `people/<name>/trail`: its last few metres;
@@ -89,7 +91,9 @@ struct Track {
     styled: bool,
 }
 
-pub(super) fn colour(index: u32) -> rerun::Color {
+/// Robot `index`'s colour, kept across its entities: body, truth, scan and, as shades of it,
+/// its localizers ([`localizer_colour`]).
+fn palette(index: u32) -> [u8; 3] {
     const PALETTE: [[u8; 3]; 8] = [
         [31, 119, 180],
         [255, 127, 14],
@@ -100,7 +104,11 @@ pub(super) fn colour(index: u32) -> rerun::Color {
         [227, 119, 194],
         [23, 190, 207],
     ];
-    let c = PALETTE[index as usize % PALETTE.len()];
+    PALETTE[index as usize % PALETTE.len()]
+}
+
+pub(super) fn colour(index: u32) -> rerun::Color {
+    let c = palette(index);
     rerun::Color::from_rgb(c[0], c[1], c[2])
 }
 
@@ -274,8 +282,21 @@ fn sonar_echoes(s: &Sonars, ranges: &[f32], base: &Pose2) -> Vec<Vec<[f32; 3]>> 
 }
 
 /// Colour of a robot's `k`-th localizer (its estimate arrow, path and covariance).
-fn localizer_colour(k: usize) -> rerun::Color {
-    colour(k as u32 + 1)
+/// Localizer `k` of robot `robot`: a shade of the robot's colour (its truth has the colour
+/// itself), darker for even `k` and lighter for odd, farther from it with each pair.
+pub(super) fn localizer_colour(robot: u32, k: usize) -> rerun::Color {
+    let t = (0.3 + 0.2 * (k / 2) as f32).min(0.8);
+    let shade = |c: u8| {
+        let c = c as f32;
+        let v = if k.is_multiple_of(2) {
+            c * (1.0 - t)
+        } else {
+            c + (255.0 - c) * t
+        };
+        v.round() as u8
+    };
+    let [r, g, b] = palette(robot);
+    rerun::Color::from_rgb(shade(r), shade(g), shade(b))
 }
 
 impl RrdRecorder {
@@ -297,26 +318,23 @@ impl RrdRecorder {
             self.tracks[robot].resize_with(k + 1, Track::default);
         }
         let name = &l.name;
-        let c = localizer_colour(k);
+        let c = localizer_colour(robot as u32, k);
         let est_path = format!("{base}/estimate/{name}");
         let err_path = format!("{base}/error/{name}");
-        let heading_path = format!("{err_path}/heading");
+        let heading_path = format!("{base}/heading_error/{name}");
         if !self.tracks[robot][k].styled {
             self.tracks[robot][k].styled = true;
-            let res = self.rec.log_static(
-                err_path.as_str(),
-                &rerun::SeriesLines::new()
-                    .with_names([format!("{name} position error (m)")])
-                    .with_colors([c]),
-            );
-            self.check(res);
-            let res = self.rec.log_static(
-                heading_path.as_str(),
-                &rerun::SeriesLines::new()
-                    .with_names([format!("{name} heading error (rad)")])
-                    .with_colors([c]),
-            );
-            self.check(res);
+            // `robots/r1` → "r1 mcl": the legend names the robot and the localizer
+            let label = format!("{} {name}", base.trim_start_matches("robots/"));
+            for path in [&err_path, &heading_path] {
+                let res = self.rec.log_static(
+                    path.as_str(),
+                    &rerun::SeriesLines::new()
+                        .with_names([label.as_str()])
+                        .with_colors([c]),
+                );
+                self.check(res);
+            }
         }
         // the eval system paired this tick's estimates with ground truth: they are the tail
         let fresh = l.fresh.len();
