@@ -8,11 +8,8 @@ use systems::world::distance_field::{squared_distances, squared_distances_plain}
 use systems::world::map_file::load_map;
 
 fn distance_field(c: &mut Criterion) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../assets/maps/hospital/hospital.yaml"
-    );
-    let grid = load_map(std::path::Path::new(path)).expect("hospital map");
+    let path = systems::core::source::source_path("assets/maps/hospital/hospital.yaml");
+    let grid = load_map(&path).expect("hospital map");
     let (w, h) = (grid.width, grid.height);
     let occ = |x: usize, y: usize| grid.is_obstacle(x, y);
     let mut g = c.benchmark_group("squared_distances");

@@ -469,10 +469,11 @@ mod tests {
     /// floor and on shapes whose sides are not multiples of the transpose block.
     #[test]
     fn the_fast_transform_equals_the_plain_one() {
-        let hospital = crate::world::map_file::load_map(std::path::Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../assets/maps/hospital/hospital.yaml"
-        )))
+        // found at run time (core::source): a test binary from a shared build cache may have
+        // been compiled in another clone
+        let hospital = crate::world::map_file::load_map(&crate::core::source::source_path(
+            "assets/maps/hospital/hospital.yaml",
+        ))
         .unwrap();
         let occ = |x: usize, y: usize| hospital.is_obstacle(x, y);
         let (w, h) = (hospital.width, hospital.height);
