@@ -20,11 +20,14 @@ const SYSTEMS_LEVELS: &[&[&str]] = &[
     &["prelude", "robot"],
 ];
 
+/// `krate`'s sources in the clone the test runs in: cargo's `CARGO_MANIFEST_DIR` at run time
+/// (a test binary from a build cache shared between clones may have been compiled in another
+/// one, whose sources it would check instead), else where it was compiled.
 fn src(krate: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join(krate)
-        .join("src")
+    let tests_dir = std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")));
+    tests_dir.join("..").join(krate).join("src")
 }
 
 fn graph(root: &Path) -> ModuleGraph {
