@@ -36,6 +36,7 @@ pub mod options;
 pub mod prelude;
 pub mod record;
 pub mod replay;
+pub mod report;
 pub mod run;
 pub mod scenario;
 pub mod stats;

@@ -171,26 +171,27 @@ fn fmt(v: f64) -> String {
     }
 }
 
+/// `key=value` of the parameters of `st` that are not the same in every set of `stats`.
+pub fn differing_params(st: &SetStats, stats: &[SetStats]) -> Vec<String> {
+    let value = |set: &SetStats, k: &str| {
+        set.params
+            .iter()
+            .find(|(c, _)| c == k)
+            .map(|(_, v)| v.clone())
+    };
+    st.params
+        .iter()
+        .filter(|(k, _)| stats.iter().any(|o| value(o, k) != value(&stats[0], k)))
+        .map(|(k, v)| format!("{}={}", k.trim_start_matches("set."), cell(v)))
+        .collect()
+}
+
 /// The printed table: per set, the parameters that differ between sets, run and failure
 /// counts, and the main metrics.
 pub fn table(stats: &[SetStats]) -> String {
-    let varies = |k: &str| {
-        let v = |st: &SetStats| {
-            st.params
-                .iter()
-                .find(|(c, _)| c == k)
-                .map(|(_, v)| v.clone())
-        };
-        stats.iter().any(|st| v(st) != v(&stats[0]))
-    };
     let mut s = String::new();
     for st in stats {
-        let params: Vec<String> = st
-            .params
-            .iter()
-            .filter(|(k, _)| varies(k))
-            .map(|(k, v)| format!("{}={}", k.trim_start_matches("set."), cell(v)))
-            .collect();
+        let params = differing_params(st, stats);
         s += &format!(
             "set {}{}{}: {} runs, {} failed\n",
             st.set,

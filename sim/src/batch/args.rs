@@ -53,6 +53,10 @@ pub struct BatchArgs {
     /// (`set<S>-seed<N>.rrd`).
     #[arg(long)]
     pub rrd: bool,
+    /// Also write report.html into the output folder: a self-contained page with the
+    /// parameter sets, the aggregate table and a box plot of every metric per set.
+    #[arg(long)]
+    pub report: bool,
     /// No progress bar and no table, only errors.
     #[arg(long)]
     pub quiet: bool,

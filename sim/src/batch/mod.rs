@@ -322,6 +322,15 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
             out_dir.display()
         )
     })?;
+    if a.report {
+        let page = out_dir.join(crate::report::PAGE);
+        if page.exists() {
+            anyhow::bail!(
+                "{}: a report is already there; choose another --out or remove it",
+                page.display()
+            );
+        }
+    }
     if !a.quiet {
         let shard = a
             .shard
@@ -346,6 +355,13 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
     output::write_jsonl(&out_dir.join("runs.jsonl"), &r.rows)?;
     aggregate::write_aggregate(&out_dir.join("aggregate.csv"), &r.stats)?;
     b.manifest.write(&out_dir)?;
+    let page = if a.report {
+        Some(crate::report::write_batch(
+            &out_dir, &b.name, &r.rows, &r.stats,
+        )?)
+    } else {
+        None
+    };
     let wall_s = started.elapsed().as_secs_f64();
     if !a.quiet {
         print!("{}", r.table);
@@ -356,6 +372,9 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
             r.failed,
             out_dir.display()
         );
+        if let Some(p) = &page {
+            println!("report written to {}", p.display());
+        }
     }
     Ok(BatchReport {
         out_dir,

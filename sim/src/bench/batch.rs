@@ -61,6 +61,7 @@ pub fn run_batch_bench(o: &BenchBatchArgs) -> anyhow::Result<BatchBenchRow> {
         out: None,
         shard: None,
         rrd: false,
+        report: false,
         quiet: true,
     };
     let b = batch::prepare(&args)?;

@@ -41,6 +41,9 @@ pub enum Command {
     Replay(crate::replay::ReplayArgs),
     /// Run a SLAM system on a recorded CARMEN log (e.g. one written by `sim run --carmen-out`).
     Slam(crate::log_slam::SlamArgs),
+    /// Draw the HTML report again from what `sim run --report` (report.json), `--summary` or
+    /// `sim batch` (runs.jsonl) wrote.
+    Report(crate::report::ReportArgs),
     /// List the bundled scenarios.
     Scenarios,
     /// Print the tick order of a scenario's run (or, with --replay, of its replay): the systems
@@ -88,6 +91,7 @@ pub fn dispatch(cmd: Command) -> anyhow::Result<()> {
             crate::replay::replay_command(&a)
         }
         Command::Slam(a) => crate::log_slam::run_slam_command(&a).map(drop),
+        Command::Report(a) => crate::report::report_command(&a),
         Command::Scenarios => {
             for (name, path) in bundled_scenarios()? {
                 let desc = load_scenario(&path)

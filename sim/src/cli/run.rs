@@ -2,6 +2,7 @@
 
 use crate::RunExports;
 use crate::options::check_duration;
+use crate::report::data::RunReport;
 use crate::run::report::{OutputArgs, report_run};
 use crate::run::run_scenario_exporting;
 use crate::scenario::scenario_arg;
@@ -31,6 +32,11 @@ pub struct RunArgs {
     /// GPS, compass, camera, sonars, tf), for `sim replay` and ROS tools.
     #[arg(long)]
     pub mcap: Option<PathBuf>,
+    /// Write an HTML report into this folder (created if missing): report.html, one page with
+    /// inline figures (the map with every robot's true and estimated paths, error over time,
+    /// the task timeline) and the summary tables, and report.json, its data for `sim report`.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
 }
 
 /// `sim run`.
@@ -41,6 +47,9 @@ pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
     }
     if let Some(d) = a.duration {
         sc.duration = check_duration(d)?;
+    }
+    if let Some(dir) = &a.report {
+        crate::report::prepare_dir(dir)?;
     }
     let rrd_path = a
         .out
@@ -54,14 +63,28 @@ pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
             sc.seed
         );
     }
+    let mut opts = a.out.run_options(rrd_path.clone());
+    if a.report.is_some() {
+        // the true paths of the report's map
+        opts.trajectory_period = Some(REPORT_TRUTH_PERIOD_S);
+    }
     let out = run_scenario_exporting(
         &sc,
-        &a.out.run_options(rrd_path.clone()),
+        &opts,
         &RunExports {
             carmen_out: a.carmen_out.clone(),
             save_map: a.out.save_map.clone(),
             mcap: a.mcap.clone(),
         },
     )?;
+    if let Some(dir) = &a.report {
+        let page = crate::report::write_run(dir, &RunReport::of_run(&sc, &out)?)?;
+        if !a.out.quiet {
+            println!("report written to {}", page.display());
+        }
+    }
     report_run(&out, &a.out.report(rrd_path.as_deref(), a.log.as_deref()))
 }
+
+/// Seconds between the true poses a report's map draws.
+const REPORT_TRUTH_PERIOD_S: f64 = 0.1;

@@ -112,6 +112,8 @@ pub struct RecordFile {
     pub slam_rate: Option<f64>,
     /// Camera images per second.
     pub camera_rate: Option<f64>,
+    /// The localizer the recording's map view shows (of the robots that have one by this name).
+    pub map_localizer: Option<String>,
 }
 
 /// One `[[robots]]` table.

@@ -64,6 +64,9 @@ pub struct RecordConfig {
     pub slam_rate: f64,
     /// Camera images per second (JPEG, with the recognized road drawn in).
     pub camera_rate: f64,
+    /// The localizer the recording's map view shows for the robots that have it (None: each
+    /// robot's first).
+    pub map_localizer: Option<String>,
 }
 
 impl Default for RecordConfig {
@@ -76,6 +79,7 @@ impl Default for RecordConfig {
             particle_points: 1000,
             slam_rate: 0.5,
             camera_rate: 1.0,
+            map_localizer: None,
         }
     }
 }

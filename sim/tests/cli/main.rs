@@ -10,6 +10,7 @@ mod experiment;
 mod interrupt;
 mod matching;
 mod replay;
+mod report;
 mod run;
 mod schedule;
 mod threads;

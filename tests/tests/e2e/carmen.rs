@@ -136,8 +136,8 @@ fn a_run_exported_as_carmen_replays_through_slam() {
         "/robots/loop/slam/map",
         "/robots/loop/slam/trajectory",
         "/robots/loop/slam/scan",
-        "/robots/loop/odometry",
-        "/robots/loop/truth",
+        "/robots/loop/odometry/path",
+        "/robots/loop/truth/path",
     ] {
         assert!(
             paths.iter().any(|p| p == want),

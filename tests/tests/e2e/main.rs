@@ -8,6 +8,7 @@ mod carmen;
 mod common;
 mod determinism;
 mod events;
+mod layout;
 mod localization;
 mod mcap;
 mod navigation;

@@ -273,3 +273,28 @@ fn hospital_patrol_robots_make_progress() {
         }
     }
 }
+
+/// `[record] map_localizer` must name a localizer some robot has; the error lists them.
+#[test]
+fn a_map_localizer_no_robot_has_is_an_error() {
+    let line_of = |text: &str| {
+        text.lines()
+            .position(|l| l.starts_with("map_localizer"))
+            .unwrap()
+            + 1
+    };
+    let text = format!("{}\n[record]\nmap_localizer = \"amcl\"\n", with_robot(""));
+    expect_error(
+        &text,
+        line_of(&text),
+        &["record.map_localizer", "'amcl'", "localizers: none"],
+    );
+    // a name some robot has is fine, and the error lists the robots' localizers
+    let robot = "[robots.sensors.laser]\npreset = \"sick_lms100\"\n[robots.sensors.encoder]\n\
+                 [[robots.localization]]\ntype = \"mcl\"\ninit = \"pose\"\n";
+    let ok = format!("{}\n[record]\nmap_localizer = \"mcl\"\n", with_robot(robot));
+    let s = scenario(&ok);
+    assert_eq!(s.record.map_localizer.as_deref(), Some("mcl"));
+    let bad = ok.replace("map_localizer = \"mcl\"", "map_localizer = \"amcl\"");
+    expect_error(&bad, line_of(&bad), &["'amcl'", "localizers: mcl"]);
+}

@@ -46,7 +46,7 @@ pub fn colormap(t: f64) -> [u8; 3] {
 pub struct Cloud {
     pub points: Vec<[f32; 3]>,
     pub colors: Vec<[u8; 3]>,
-    /// Point radius (m).
+    /// Point radius (UI points: visible at every zoom).
     pub radius: f32,
 }
 
@@ -72,7 +72,7 @@ pub fn mcl_cloud(m: &Mcl, cap: usize) -> Cloud {
             .iter()
             .map(|&i| colormap(if w_max > 0.0 { m.w[i] / w_max } else { 0.0 }))
             .collect(),
-        radius: 0.04,
+        radius: 1.5,
     }
 }
 
@@ -95,7 +95,7 @@ pub fn population_cloud(poses: &[[f64; 3]], costs: &[f64], cap: usize) -> Cloud 
             .iter()
             .map(|&r| colormap(1.0 - r as f64 / last))
             .collect(),
-        radius: 0.05,
+        radius: 2.0,
     }
 }
 
@@ -132,7 +132,7 @@ pub fn grid_cloud(g: &MarkovGrid, cap: usize) -> Cloud {
             .iter()
             .map(|&k| colormap((marginal[cells[k]] / floor).ln() / span))
             .collect(),
-        radius: (0.5 * l.resolution) as f32,
+        radius: 2.5,
     }
 }
 
@@ -174,7 +174,7 @@ pub fn points_cloud(points: &[([f64; 2], f64)], cap: usize) -> Cloud {
             .map(|&i| [points[i].0[0] as f32, points[i].0[1] as f32, 0.0])
             .collect(),
         colors: idx.iter().map(|&i| colormap(points[i].1)).collect(),
-        radius: 0.04,
+        radius: 1.5,
     }
 }
 

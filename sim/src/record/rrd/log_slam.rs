@@ -1,9 +1,9 @@
 //! The recording of `sim slam`: a SLAM system replaying a CARMEN log. Entities as in `sim run`
 //! (`systems/ARCHITECTURE.md`, "Entity paths"), for the robot named after the log: its SLAM system under `robots/<name>/slam`
-//! ([`super::slam`]), its wheel odometry `robots/<name>/odometry` and, when the log has
-//! `TRUEPOS` lines, its true path `robots/<name>/truth` (line strips in their own frames, the
-//! odometry frame for a log of `sim run --carmen-out`). The `sim_time` timeline counts seconds
-//! from the log's first record.
+//! ([`super::slam`]), its wheel odometry path `robots/<name>/odometry/path` and, when the log has
+//! `TRUEPOS` lines, its true path `robots/<name>/truth/path` (new segments, in their own frames,
+//! the odometry frame for a log of `sim run --carmen-out`), and the default layout
+//! ([`super::blueprint`]). The `sim_time` timeline counts seconds from the log's first record.
 
 use super::path_trace::PathTrace;
 use super::slam::{SlamTrack, log_slam_scan, log_slam_state, slam_entity};
@@ -89,18 +89,17 @@ impl ReplayRecorder {
         self.check(res);
         let grey = rerun::Color::from_rgb(150, 150, 150);
         for (leaf, path, colour) in [
-            ("odometry", &self.odometry, grey),
-            ("truth", &self.truth, rerun::Color::from_rgb(31, 119, 180)),
+            ("odometry", &mut self.odometry, grey),
+            (
+                "truth",
+                &mut self.truth,
+                rerun::Color::from_rgb(31, 119, 180),
+            ),
         ] {
-            let strips = path.strips();
-            if strips.iter().any(|s| s.len() >= 2) {
-                let strip = rerun::LineStrips3D::new(strips).with_colors([colour]);
-                let res = self
-                    .rec
-                    .log(format!("robots/{}/{leaf}", self.robot), &strip);
-                if let Err(e) = res {
-                    self.error.get_or_insert_with(|| e.to_string());
-                }
+            let strips = path.take_new();
+            if !strips.is_empty() {
+                let entity = format!("robots/{}/{leaf}/path", self.robot);
+                super::rows::path(&mut self.rec, &entity, strips, colour);
             }
         }
     }
@@ -109,6 +108,18 @@ impl ReplayRecorder {
     pub fn finish(mut self, est: &dyn ScanEstimator, stamp: f64) -> anyhow::Result<()> {
         self.rec.set_duration_secs("sim_time", stamp - self.t0);
         self.log_state(est);
+        let paths = self.rec.entity_paths();
+        let layout = super::blueprint::default_layout(&super::blueprint::Inputs {
+            paths: &paths,
+            position_axis: 0.5,
+            heading_axis: 0.2,
+            drift_axis: 0.5,
+            time_span: Some([0.0, self.rec.latest_secs()]),
+            ..Default::default()
+        });
+        if let Err(e) = super::blueprint::send(&self.rec, &layout) {
+            self.error.get_or_insert_with(|| format!("{e:#}"));
+        }
         close_recording(&mut self.rec, self.error.take())
     }
 }

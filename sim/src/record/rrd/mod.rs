@@ -24,15 +24,19 @@
 //!   recorder reads ground truth; the localizers never do. A robot keeps one colour across its
 //!   entities, its localizers as shades of it.
 //!
-//! - `people/<name>`: each walking person as a disc of its radius (a point with that radius,
-//!   labelled with its name) at the pose rate, and `people/<name>/trail`: its last few metres;
+//! - `people/<name>`: each walking person as a flat disc of its radius on the floor, labelled
+//!   with its name, at the pose rate, and `people/<name>/trail`: its last few metres;
 //! - `events` and `robots/<name>/collisions`: the run's events as text-log lines
-//!   ([`events`]).
+//!   ([`events`]); `robots/<name>/localization`: when each localizer converged and when it
+//!   lost its robot ([`localizer_status`]).
 //!
-//! Everything is 3-D with z = 0 (z up), so the default 3-D view shows the floor plan from above.
+//! Everything is 3-D (z up): the maps below z = 0 (`world/map` at [`MAP_Z`]), everything else
+//! on or just above it, so a view from above shows the overlays over the floor plan.
 
 pub mod belief;
+pub mod blueprint;
 pub mod events;
+pub mod localizer_status;
 pub mod log_slam;
 pub mod navigation;
 pub mod outdoor;
@@ -47,6 +51,7 @@ pub use plugin::RrdPlugin;
 use crate::scenario::RecordConfig;
 use belief::Cloud;
 use bevy_ecs::prelude::*;
+use blueprint::AxisScale;
 use path_trace::PathTrace;
 use std::collections::VecDeque;
 use std::path::Path;
@@ -58,6 +63,11 @@ use systems::eval::LocalizationSamples;
 use systems::localization::{Localizer, Localizers, PoseEstimate, WheelOdometry};
 use systems::sensors::{LaserScans, LaserTruth, SonarReadings, SonarTruth, Sonars};
 use systems::world::{Cell, OccupancyGrid};
+
+/// Height of `world/map`: the map is the floor, everything else is drawn above it (far enough
+/// for the depth buffer of a view from 200 m up: overlays a few centimetres above the map
+/// flicker into it).
+pub const MAP_Z: f64 = -0.3;
 
 /// Points kept in a person's trail (at the pose rate: 3 s at the default 10 Hz).
 const TRAIL_POINTS: usize = 30;
@@ -79,6 +89,15 @@ pub struct RrdRecorder {
     /// The first logging error, reported when the run ends.
     pub error: Option<String>,
     due: Vec<f64>,
+    /// What the blueprint is made from: the known part of the map (min x, min y, max x,
+    /// max y), the localizer the map shows, and the spread of the plotted errors.
+    bounds: Option<[f64; 4]>,
+    map_localizer: Option<String>,
+    pub(super) position_scale: AxisScale,
+    heading_scale: AxisScale,
+    drift_scale: AxisScale,
+    /// Per robot (by index): whether its drift series' style was logged.
+    drift_styled: Vec<bool>,
 }
 
 /// What the recorder keeps per localizer.
@@ -89,27 +108,14 @@ struct Track {
     particles_at: Option<f64>,
     /// Whether the series styles were logged.
     styled: bool,
+    /// Converged or not, for the text log.
+    status: localizer_status::Status,
 }
 
-/// Robot `index`'s colour, kept across its entities: body, truth, scan and, as shades of it,
-/// its localizers ([`localizer_colour`]).
-fn palette(index: u32) -> [u8; 3] {
-    const PALETTE: [[u8; 3]; 8] = [
-        [31, 119, 180],
-        [255, 127, 14],
-        [44, 160, 44],
-        [214, 39, 40],
-        [148, 103, 189],
-        [140, 86, 75],
-        [227, 119, 194],
-        [23, 190, 207],
-    ];
-    PALETTE[index as usize % PALETTE.len()]
-}
-
+/// Robot `index`'s colour ([`crate::record::colours`]).
 pub(super) fn colour(index: u32) -> rerun::Color {
-    let c = palette(index);
-    rerun::Color::from_rgb(c[0], c[1], c[2])
+    let [r, g, b] = crate::record::colours::robot(index);
+    rerun::Color::from_rgb(r, g, b)
 }
 
 impl RrdRecorder {
@@ -134,6 +140,12 @@ impl RrdRecorder {
             particle_points: config.particle_points,
             error: None,
             due: Vec::new(),
+            bounds: known_bounds(grid),
+            map_localizer: config.map_localizer.clone(),
+            position_scale: AxisScale::default(),
+            heading_scale: AxisScale::default(),
+            drift_scale: AxisScale::default(),
+            drift_styled: Vec::new(),
         };
         r.log_static_world(grid);
         Ok(r)
@@ -160,17 +172,52 @@ impl RrdRecorder {
             data,
             [grid.width, grid.height],
             grid.resolution,
-            [grid.origin[0], grid.origin[1], -0.01],
+            [grid.origin[0], grid.origin[1], MAP_Z],
             rerun::components::Colormap::RvizMap,
         );
         let res = self.rec.log_static("world/map", &map);
         self.check(res);
     }
 
-    /// Flushes everything to disk; returns the first error seen.
+    /// Sends the default layout ([`blueprint`]), flushes everything to disk; returns the first
+    /// error seen.
     pub fn finish(&mut self) -> anyhow::Result<()> {
+        let paths = self.rec.entity_paths();
+        let layout = blueprint::default_layout(&blueprint::Inputs {
+            paths: &paths,
+            map_localizer: self.map_localizer.as_deref(),
+            bounds: self.bounds,
+            position_axis: self.position_scale.top(0.75, 0.5),
+            heading_axis: self.heading_scale.top(0.75, 0.2),
+            drift_axis: self.drift_scale.top(1.0, 0.5),
+            time_span: Some([0.0, self.rec.latest_secs()]),
+        });
+        if let Err(e) = blueprint::send(&self.rec, &layout) {
+            self.error.get_or_insert_with(|| format!("{e:#}"));
+        }
         close_recording(&mut self.rec, self.error.take())
     }
+}
+
+/// The extent of the grid's known cells (free or occupied), or None when all are unknown.
+fn known_bounds(grid: &OccupancyGrid) -> Option<[f64; 4]> {
+    let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+    for (k, c) in grid.cells.iter().enumerate() {
+        if *c != Cell::Unknown {
+            let (x, y) = (k % grid.width, k / grid.width);
+            lo = [lo[0].min(x), lo[1].min(y)];
+            hi = [hi[0].max(x), hi[1].max(y)];
+        }
+    }
+    (lo[0] <= hi[0]).then(|| {
+        let at = |i: usize, axis: usize| grid.origin[axis] + i as f64 * grid.resolution;
+        [
+            at(lo[0], 0),
+            at(lo[1], 1),
+            at(hi[0] + 1, 0),
+            at(hi[1] + 1, 1),
+        ]
+    })
 }
 
 /// Flushes a recording to disk; returns `error` (the first logging error seen) or the flush's.
@@ -190,7 +237,7 @@ pub(super) fn scan_cloud(
     c: rerun::Color,
 ) -> rerun::Points3D {
     rerun::Points3D::new(scan_points(scan, sensor))
-        .with_radii([0.03])
+        .with_radii([rerun::components::Radius::new_ui_points(1.5)])
         .with_colors([c])
 }
 
@@ -251,7 +298,8 @@ pub(super) fn grid_map(
 
 /// A particle set's row.
 fn log_cloud(rec: &mut RrdStream, path: &str, c: &Cloud) {
-    rows::points(rec, path, c.points.iter().copied(), c.radius).with(
+    let radius = rerun::components::Radius::new_ui_points(c.radius);
+    rows::points(rec, path, c.points.iter().copied(), radius).with(
         rerun::Points3D::descriptor_colors(),
         c.colors
             .iter()
@@ -281,22 +329,10 @@ fn sonar_echoes(s: &Sonars, ranges: &[f32], base: &Pose2) -> Vec<Vec<[f32; 3]>> 
         .collect()
 }
 
-/// Colour of a robot's `k`-th localizer (its estimate arrow, path and covariance).
-/// Localizer `k` of robot `robot`: a shade of the robot's colour (its truth has the colour
-/// itself), darker for even `k` and lighter for odd, farther from it with each pair.
+/// Colour of a robot's `k`-th localizer: a shade of the robot's ([`crate::record::colours`]).
 pub(super) fn localizer_colour(robot: u32, k: usize) -> rerun::Color {
-    let t = (0.3 + 0.2 * (k / 2) as f32).min(0.8);
-    let shade = |c: u8| {
-        let c = c as f32;
-        let v = if k.is_multiple_of(2) {
-            c * (1.0 - t)
-        } else {
-            c + (255.0 - c) * t
-        };
-        v.round() as u8
-    };
-    let [r, g, b] = palette(robot);
-    rerun::Color::from_rgb(shade(r), shade(g), shade(b))
+    let [r, g, b] = crate::record::colours::localizer(robot, k);
+    rerun::Color::from_rgb(r, g, b)
 }
 
 impl RrdRecorder {
@@ -343,9 +379,24 @@ impl RrdRecorder {
         if paired {
             for s in &samples[samples.len() - fresh..] {
                 self.rec.set_duration_secs("sim_time", s.t);
-                rows::scalar(&mut self.rec, &err_path, s.position_error());
+                let e = s.position_error();
+                rows::scalar(&mut self.rec, &err_path, e);
                 let dth = wrap_angle(s.estimate.theta - s.truth.theta).abs();
                 rows::scalar(&mut self.rec, &heading_path, dth);
+                self.position_scale.push(e);
+                self.heading_scale.push(dth);
+                if let Some(change) = self.tracks[robot][k].status.update(s) {
+                    let robot_name = base.trim_start_matches("robots/");
+                    let level = match change {
+                        localizer_status::Change::Converged { .. } => rerun::TextLogLevel::INFO,
+                        localizer_status::Change::Lost { .. } => rerun::TextLogLevel::WARN,
+                    };
+                    let res = self.rec.log(
+                        format!("{base}/localization"),
+                        &rerun::TextLog::new(change.line(robot_name, name)).with_level(level),
+                    );
+                    self.check(res);
+                }
             }
         }
         for e in &l.fresh {
@@ -367,9 +418,11 @@ impl RrdRecorder {
             }
         }
         self.rec.set_duration_secs("sim_time", now);
-        if paths_due && !self.tracks[robot][k].path.is_empty() {
-            let strips = self.tracks[robot][k].path.strips();
-            rows::strips(&mut self.rec, &est_path, strips, c);
+        if paths_due {
+            let strips = self.tracks[robot][k].path.take_new();
+            if !strips.is_empty() {
+                rows::path(&mut self.rec, &format!("{est_path}/path"), strips, c);
+            }
         }
     }
 
@@ -468,14 +521,35 @@ pub fn record_rrd(
             );
             if let Some(o) = odom {
                 rows::arrow(&mut r.rec, &format!("{base}/odometry"), &o.pose, 0.4, grey);
+                let drift = (o.pose.x - truth.pose.x).hypot(o.pose.y - truth.pose.y);
+                let drift_path = format!("{base}/odometry/drift");
+                if !r.drift_styled.get(i).copied().unwrap_or(false) {
+                    if r.drift_styled.len() <= i {
+                        r.drift_styled.resize(i + 1, false);
+                    }
+                    r.drift_styled[i] = true;
+                    let res = r.rec.log_static(
+                        drift_path.as_str(),
+                        &rerun::SeriesLines::new()
+                            .with_names([format!("{} odometry", id.0)])
+                            .with_colors([c]),
+                    );
+                    r.check(res);
+                }
+                rows::scalar(&mut r.rec, &drift_path, drift);
+                r.drift_scale.push(drift);
             }
         }
         if paths_due {
-            let strips = r.truth_paths[i].strips();
-            rows::strips(&mut r.rec, &format!("{base}/truth"), strips, c);
+            let strips = r.truth_paths[i].take_new();
+            if !strips.is_empty() {
+                rows::path(&mut r.rec, &format!("{base}/truth/path"), strips, c);
+            }
             if odom.is_some() {
-                let strips = r.odom_paths[i].strips();
-                rows::strips(&mut r.rec, &format!("{base}/odometry"), strips, grey);
+                let strips = r.odom_paths[i].take_new();
+                if !strips.is_empty() {
+                    rows::path(&mut r.rec, &format!("{base}/odometry/path"), strips, grey);
+                }
             }
         }
         if scans_due
@@ -486,7 +560,7 @@ pub fn record_rrd(
                 &mut r.rec,
                 &format!("{base}/scan"),
                 scan_points(scan, pose),
-                0.03,
+                rerun::components::Radius::new_ui_points(1.5),
             )
             .with(rerun::Points3D::descriptor_colors(), [c]);
         }
@@ -500,7 +574,8 @@ pub fn record_rrd(
     }
 }
 
-/// Logs every person (in index order) as a disc of its radius and its recent trail.
+/// Logs every person (in index order) as a flat disc of its radius on the floor, labelled with
+/// its name, and its recent trail.
 fn record_people(
     r: &mut RrdRecorder,
     people: &Query<(&PersonIndex, &PersonId, &Person, &TruePose)>,
@@ -520,10 +595,24 @@ fn record_people(
         }
         trail.push_back(p);
         let base = format!("people/{}", id.0);
-        rows::points(&mut r.rec, &base, [p], person.radius as f32)
-            .with(rerun::Points3D::descriptor_colors(), [c])
+        let radius = person.radius as f32;
+        r.rec
+            .row(&base)
             .with(
-                rerun::Points3D::descriptor_labels(),
+                rerun::Ellipsoids3D::descriptor_centers(),
+                [rerun::components::Translation3D::from(p)],
+            )
+            .with(
+                rerun::Ellipsoids3D::descriptor_half_sizes(),
+                [rerun::components::HalfSize3D::from([radius, radius, 0.02])],
+            )
+            .with(
+                rerun::Ellipsoids3D::descriptor_fill_mode(),
+                [rerun::components::FillMode::Solid],
+            )
+            .with(rerun::Ellipsoids3D::descriptor_colors(), [c])
+            .with(
+                rerun::Ellipsoids3D::descriptor_labels(),
                 [rerun::components::Text::from(id.0.as_str())],
             );
         if trail.len() >= 2 {

@@ -12,6 +12,7 @@
 
 use super::RrdRecorder;
 use bevy_ecs::prelude::*;
+use rerun::components::Radius;
 use systems::core::{RobotId, RobotIndex, SimClock};
 use systems::localization::NavBelief;
 use systems::navigation::{Costmap, NavCostmaps, Navigator};
@@ -41,7 +42,7 @@ fn costmap_grid(map: &Costmap) -> rerun::GridMap {
         data,
         [map.width, map.height],
         map.resolution,
-        [map.origin[0], map.origin[1], -0.005],
+        [map.origin[0], map.origin[1], -0.2],
         rerun::components::Colormap::RvizCostmap,
     )
 }
@@ -90,7 +91,7 @@ pub fn record_navigation(
             let res = r.rec.log(
                 format!("{base}/path"),
                 &rerun::LineStrips3D::new([pts])
-                    .with_radii([0.03])
+                    .with_radii([Radius::new_ui_points(1.5)])
                     .with_colors([rerun::Color::from_rgb(40, 200, 80)]),
             );
             r.check(res);
@@ -98,7 +99,7 @@ pub fn record_navigation(
                 let res = r.rec.log(
                     format!("{base}/goal"),
                     &rerun::Points3D::new([[g.pose.x as f32, g.pose.y as f32, 0.02]])
-                        .with_radii([0.15])
+                        .with_radii([Radius::new_ui_points(5.0)])
                         .with_labels([g.name.as_str()]),
                 );
                 r.check(res);
@@ -122,7 +123,7 @@ pub fn record_navigation(
                 let res = r.rec.log(
                     format!("{base}/stops"),
                     &rerun::Points3D::new([[p.x as f32, p.y as f32, 0.03]])
-                        .with_radii([0.12])
+                        .with_radii([Radius::new_ui_points(3.5)])
                         .with_colors([rerun::Color::from_rgb(230, 60, 40)]),
                 );
                 r.check(res);

@@ -111,7 +111,7 @@ fn log_roads(r: &mut RrdRecorder, g: &RoadGraph, zones: Option<&Zones>) {
         .map(|road| {
             road.nodes
                 .iter()
-                .map(|&n| [g.nodes[n].pos[0] as f32, g.nodes[n].pos[1] as f32, -0.01])
+                .map(|&n| [g.nodes[n].pos[0] as f32, g.nodes[n].pos[1] as f32, -0.1])
                 .collect()
         })
         .collect();
@@ -131,7 +131,7 @@ fn log_roads(r: &mut RrdRecorder, g: &RoadGraph, zones: Option<&Zones>) {
                 .iter()
                 .map(|&n| [g.nodes[n].pos[0] as f32, g.nodes[n].pos[1] as f32, 0.0]),
         )
-        .with_radii([0.4])
+        .with_radii([Radius::new_ui_points(3.0)])
         .with_colors([rerun::Color::from_rgb(250, 250, 250)])
         .with_labels(junctions.iter().map(|&n| g.nodes[n].source.clone())),
     );
@@ -164,7 +164,7 @@ fn log_roads(r: &mut RrdRecorder, g: &RoadGraph, zones: Option<&Zones>) {
         let res = r.rec.log_static(
             format!("world/zones/{}", z.name),
             &rerun::LineStrips3D::new([pts])
-                .with_radii([0.15])
+                .with_radii([Radius::new_ui_points(1.5)])
                 .with_colors([rerun::Color::from_rgb(c[0], c[1], c[2])])
                 .with_labels([format!("{} ({})", z.name, z.kind.as_str())]),
         );
@@ -214,12 +214,31 @@ pub fn record_outdoor(
         }
         let (pose_period, particle_period) = (state.pose_period, state.particle_period);
         let logged = &mut state.robots[i];
-        let paths = logged.paths.get_or_insert_with(|| {
+        if logged.paths.is_none() {
             let names: Vec<String> = loc
                 .map(|l| l.slots.iter().map(|s| s.name.to_string()).collect())
                 .unwrap_or_default();
-            Paths::new(&id.0, &names)
-        });
+            let paths = Paths::new(&id.0, &names);
+            // legends name the robot; the GPS in the robot's colour, road localizers as shades
+            let series = std::iter::once((&paths.gps_error, "gps", super::colour(idx.0))).chain(
+                names
+                    .iter()
+                    .zip(&paths.slots)
+                    .enumerate()
+                    .map(|(k, (n, s))| (&s[1], n.as_str(), super::localizer_colour(idx.0, k))),
+            );
+            for (path, name, c) in series {
+                let res = r.rec.log_static(
+                    path.as_str(),
+                    &rerun::SeriesLines::new()
+                        .with_names([format!("{} {name}", id.0)])
+                        .with_colors([c]),
+                );
+                r.check(res);
+            }
+            logged.paths = Some(paths);
+        }
+        let Some(paths) = &logged.paths else { continue };
         r.rec.set_duration_secs("sim_time", now);
         let p = [truth.pose.x, truth.pose.y];
         if let Some(loc) = loc {
@@ -229,7 +248,7 @@ pub fn record_outdoor(
                     &mut r.rec,
                     &paths.gps,
                     [[xy[0] as f32, xy[1] as f32, 0.05]],
-                    0.3,
+                    Radius::new_ui_points(2.5),
                 )
                 .with(
                     rerun::Points3D::descriptor_colors(),
@@ -237,6 +256,7 @@ pub fn record_outdoor(
                 );
                 let err = (xy[0] - p[0]).hypot(xy[1] - p[1]);
                 rows::scalar(&mut r.rec, &paths.gps_error, err);
+                r.position_scale.push(err);
             }
             r.rec.set_duration_secs("sim_time", now);
             let pose_due = now >= logged.poses_at + pose_period - 1e-9;
@@ -254,10 +274,10 @@ pub fn record_outdoor(
                         100.0 * e.confidence
                     );
                     let at = [e.xy[0] as f32, e.xy[1] as f32, 0.1];
-                    rows::points(&mut r.rec, estimate, [at], 0.5)
+                    rows::points(&mut r.rec, estimate, [at], Radius::new_ui_points(5.0))
                         .with(
                             rerun::Points3D::descriptor_colors(),
-                            [super::colour(k as u32 + 2)],
+                            [super::localizer_colour(idx.0, k)],
                         )
                         .with(
                             rerun::Points3D::descriptor_labels(),
@@ -265,6 +285,7 @@ pub fn record_outdoor(
                         );
                     let err = (e.xy[0] - p[0]).hypot(e.xy[1] - p[1]);
                     rows::scalar(&mut r.rec, error, err);
+                    r.position_scale.push(err);
                 }
                 if particles_due {
                     let cells = s.filter.belief_cells(g);
@@ -275,7 +296,7 @@ pub fn record_outdoor(
                     });
                     let radii = cells
                         .iter()
-                        .map(|c| Radius::new_scene_units(0.15 + 0.6 * (c.3 / max) as f32));
+                        .map(|c| Radius::new_ui_points(1.5 + 5.0 * (c.3 / max) as f32));
                     let colors = cells.iter().map(|c| ramp((c.3 / max) as f32));
                     r.rec
                         .row(particles)
@@ -307,7 +328,7 @@ pub fn record_outdoor(
                     let res = r.rec.log(
                         &paths.path,
                         &rerun::LineStrips3D::new([pts])
-                            .with_radii([0.25])
+                            .with_radii([Radius::new_ui_points(2.0)])
                             .with_colors([rerun::Color::from_rgb(40, 200, 80)]),
                     );
                     r.check(res);

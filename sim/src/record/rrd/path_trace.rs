@@ -1,5 +1,7 @@
-//! Driven paths as the .rrd draws them: a line strip re-logged at the path rate, so its size is
-//! what a long run pays for again and again. Points are kept only where the path bends: a point
+//! Driven paths as the .rrd draws them: line strips sent as new segments only ([`PathTrace::take_new`]),
+//! each continuing from where the last one ended, so a recording grows linearly with the run
+//! (the blueprint draws a path's rows from the start to the time cursor). Points are kept only
+//! where the path bends: a point
 //! is dropped while every point since the last kept one stays within [`TOLERANCE`] of the
 //! straight line from that kept point to the newest one (a streaming form of the
 //! Reumann–Witkam / Douglas–Peucker simplification). A 190 m park route keeps a few hundred
@@ -32,6 +34,10 @@ pub struct PathTrace {
     breaks: Vec<usize>,
     /// Time of the newest point.
     last_t: f64,
+    /// Kept points already handed out by [`PathTrace::take_new`].
+    taken: usize,
+    /// The last point handed out, where the next new segment starts (None after a jump).
+    taken_end: Option<[f32; 2]>,
 }
 
 /// Distance of `p` from the segment a–b.
@@ -84,6 +90,43 @@ impl PathTrace {
             self.pending.clear();
         }
         self.pending.push(q);
+    }
+
+    /// The path drawn since the last call, as strips continuing from where that one ended (the
+    /// union of all calls' strips is [`PathTrace::strips`], the newest points of earlier calls
+    /// included); empty when it has not moved.
+    pub fn take_new(&mut self) -> Vec<Vec<[f32; 3]>> {
+        let mut out = Vec::new();
+        let mut strip: Vec<[f32; 2]> = self.taken_end.into_iter().collect();
+        let mut breaks = self
+            .breaks
+            .iter()
+            .skip_while(|&&b| b < self.taken)
+            .peekable();
+        for i in self.taken..self.kept.len() {
+            if breaks.next_if(|&&b| b == i).is_some() {
+                if strip.len() >= 2 {
+                    out.push(std::mem::take(&mut strip));
+                }
+                strip.clear();
+            }
+            if strip.last() != Some(&self.kept[i]) {
+                strip.push(self.kept[i]);
+            }
+        }
+        if let Some(&newest) = self.pending.last()
+            && strip.last() != Some(&newest)
+        {
+            strip.push(newest);
+        }
+        self.taken = self.kept.len();
+        self.taken_end = strip.last().copied().or(self.taken_end);
+        if strip.len() >= 2 {
+            out.push(strip);
+        }
+        out.into_iter()
+            .map(|s| s.into_iter().map(|p| [p[0], p[1], 0.0]).collect())
+            .collect()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -221,6 +264,57 @@ mod tests {
         let s = t.strips();
         assert_eq!(s.len(), 3, "{s:?}");
         assert_eq!(s[1], vec![[9.0, 9.0, 0.0]]);
+    }
+
+    /// Points of `strips` as segments (pairs of end points).
+    fn segments(strips: &[Vec<[f32; 3]>]) -> Vec<[[f32; 3]; 2]> {
+        strips
+            .iter()
+            .flat_map(|s| s.windows(2).map(|w| [w[0], w[1]]))
+            .collect()
+    }
+
+    /// Taking the new segments every few points draws the same path as the whole trace: every
+    /// segment of the whole lies on a taken one (the taken ones also hold each call's newest
+    /// point, which the whole may have dropped since), none crosses a jump, and a call
+    /// without movement hands out nothing.
+    #[test]
+    fn new_segments_draw_the_whole_path_and_no_jump() {
+        let mut pts: Vec<[f64; 2]> = (0..200)
+            .map(|k| {
+                let a = k as f64 * 0.02;
+                [3.0 * a.cos(), 3.0 * a.sin()]
+            })
+            .collect();
+        pts.extend((0..100).map(|k| [20.0 + k as f64 * 0.05, 5.0]));
+        let mut t = PathTrace::default();
+        let mut taken = Vec::new();
+        for (k, p) in pts.iter().enumerate() {
+            t.push(&Pose2::new(p[0], p[1], 0.0), k as f64 * 0.1);
+            if k % 7 == 3 {
+                taken.extend(t.take_new());
+            }
+        }
+        taken.extend(t.take_new());
+        assert!(t.take_new().is_empty());
+        let taken_segments = segments(&taken);
+        // every input point lies on the taken segments
+        let on = |p: [f32; 2]| {
+            taken_segments.iter().any(|s| {
+                segment_distance(p, [s[0][0], s[0][1]], [s[1][0], s[1][1]]) <= TOLERANCE + 1e-4
+            })
+        };
+        for p in &pts {
+            assert!(on([p[0] as f32, p[1] as f32]), "{p:?} not drawn");
+        }
+        // no segment spans the jump from the circle to the line
+        for s in &taken_segments {
+            let len = (s[1][0] - s[0][0]).hypot(s[1][1] - s[0][1]);
+            assert!(len < 2.0, "{s:?} crosses the jump");
+        }
+        // the last strip ends at the newest point
+        let whole = t.strips();
+        assert_eq!(taken.last().unwrap().last(), whole.last().unwrap().last());
     }
 
     /// A robot driving fast but recorded rarely (3 m/s, a point a second) is one path; the same

@@ -32,8 +32,8 @@ use systems::sensors::{Laser, LaserScan, LaserScans};
 /// graph (`[record] slam_rate` sets it in scenarios).
 pub const MAP_PERIOD_S: f64 = 2.0;
 
-/// Height of SLAM maps: just above `world/map` (z = −0.01), below everything else.
-const MAP_Z: f64 = -0.005;
+/// Height of SLAM maps: above `world/map` and the costmap, below everything else.
+const MAP_Z: f64 = -0.15;
 
 /// The entity path of a robot's SLAM system: `robots/<robot>/slam` when it is the robot's only
 /// one, `robots/<robot>/slam/<slam>` when the robot runs `count` > 1.
@@ -60,12 +60,12 @@ pub fn map_bytes(map: &ProbGrid) -> Vec<u8> {
         .collect()
 }
 
-/// Edge colour and line radius (m) by kind: loop closures stand out.
+/// Edge colour and line radius (UI points) by kind: loop closures stand out.
 pub fn edge_style(kind: GraphEdgeKind) -> ([u8; 3], f32) {
     match kind {
-        GraphEdgeKind::Sequential | GraphEdgeKind::Local => ([150, 150, 150], 0.01),
-        GraphEdgeKind::LoopClosure => ([40, 230, 90], 0.05),
-        GraphEdgeKind::Rejected => ([220, 40, 40], 0.025),
+        GraphEdgeKind::Sequential | GraphEdgeKind::Local => ([150, 150, 150], 0.5),
+        GraphEdgeKind::LoopClosure => ([40, 230, 90], 2.0),
+        GraphEdgeKind::Rejected => ([220, 40, 40], 1.0),
     }
 }
 
@@ -93,7 +93,7 @@ pub fn log_slam_state(
     if path.len() >= 2 {
         let strip = rerun::LineStrips3D::new([path])
             .with_colors([rerun::Color::from_rgb(255, 200, 40)])
-            .with_radii([0.02]);
+            .with_radii([rerun::components::Radius::new_ui_points(1.0)]);
         rec.log(format!("{base}/trajectory"), &strip)?;
     }
     if let Some(g) = est.graph() {
@@ -120,10 +120,14 @@ fn log_graph(rec: &mut RrdStream, base: &str, g: &GraphView) -> rerun::Recording
                 .iter()
                 .map(|(c, _)| rerun::Color::from_rgb(c[0], c[1], c[2])),
         )
-        .with_radii(styles.iter().map(|(_, r)| *r));
+        .with_radii(
+            styles
+                .iter()
+                .map(|(_, r)| rerun::components::Radius::new_ui_points(*r)),
+        );
     rec.log(format!("{base}/graph"), &lines)?;
     let nodes = rerun::Points3D::new(g.nodes.iter().map(xyz))
-        .with_radii([0.04])
+        .with_radii([rerun::components::Radius::new_ui_points(1.5)])
         .with_colors([rerun::Color::from_rgb(255, 200, 40)]);
     rec.log(format!("{base}/graph/nodes"), &nodes)
 }

@@ -90,6 +90,35 @@ fn resolve_file(c: &Checker, f: ScenarioFile, base_dir: &Path, default_name: &st
         )?;
         robots.push(robot);
     }
+    // every robot's localizers: its own and, with a route, the road localizers
+    let names: std::collections::BTreeSet<&str> = robots
+        .iter()
+        .flat_map(|r| {
+            let road = r.route.as_ref().map_or(&[][..], |_| {
+                &crate::scenario::outdoor_robot::RoadLocalizerKind::ALL[..]
+            });
+            r.localizers
+                .iter()
+                .map(|x| x.name.as_str())
+                .chain(road.iter().map(|k| k.as_str()))
+        })
+        .collect();
+    if let Some(l) = &record.map_localizer
+        && !names.contains(l.as_str())
+    {
+        let names: Vec<&str> = names.into_iter().collect();
+        return c.err(
+            &root.key("record").key("map_localizer"),
+            format!(
+                "no robot has a localizer named '{l}' (the robots' localizers: {})",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            ),
+        );
+    }
     let events = crate::scenario::events::resolve_events(
         c,
         &root.key("events"),
@@ -268,6 +297,7 @@ fn resolve_record(c: &Checker, rp: &KeyPath, rec: Option<&RecordFile>) -> R<Reco
         )?,
         particle_points: rec.particle_points.unwrap_or(d.particle_points),
         camera_rate: c.opt_positive(&rp.key("camera_rate"), rec.camera_rate, d.camera_rate)?,
+        map_localizer: rec.map_localizer.clone(),
         slam_rate: match rec.slam_rate {
             Some(v) => c.range(&rp.key("slam_rate"), v, Some(0.0), None, false)?,
             None => d.slam_rate,

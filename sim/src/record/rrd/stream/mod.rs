@@ -48,6 +48,8 @@ pub struct RrdStream {
     rec: RecordingStream,
     /// The `sim_time` of the rows logged next (ns).
     time: i64,
+    /// The latest `sim_time` set (ns).
+    latest: i64,
     /// Per entity, in the order of their first row.
     pending: Vec<Columns>,
     index: HashMap<String, usize>,
@@ -63,6 +65,8 @@ pub struct RrdStream {
     spare: Vec<Option<Columns>>,
     /// Column sets with the chunk thread (sent and not back yet).
     out: usize,
+    /// Entities logged as static data, in the order of their first row.
+    statics: Vec<String>,
 }
 
 impl RrdStream {
@@ -89,6 +93,7 @@ impl RrdStream {
         RrdStream {
             rec,
             time: 0,
+            latest: 0,
             pending: Vec::new(),
             index: HashMap::new(),
             error: None,
@@ -97,6 +102,7 @@ impl RrdStream {
             emptied: std::sync::Mutex::new(emptied),
             spare: Vec::new(),
             out: 0,
+            statics: Vec::new(),
         }
     }
 
@@ -125,6 +131,12 @@ impl RrdStream {
     pub fn set_duration_secs(&mut self, timeline: &str, secs: f64) {
         debug_assert_eq!(timeline, "sim_time");
         self.time = sim_time_nanos(secs);
+        self.latest = self.latest.max(self.time);
+    }
+
+    /// The latest `sim_time` rows were logged at (s).
+    pub fn latest_secs(&self) -> f64 {
+        self.latest as f64 * 1e-9
     }
 
     /// Starts a row of entity `path` at the current time; its components are added with
@@ -182,11 +194,43 @@ impl RrdStream {
 
     /// Logs `arch` at `path` as static data (timeless), straight to the SDK.
     pub fn log_static(
-        &self,
-        path: impl Into<EntityPath>,
+        &mut self,
+        path: impl AsRef<str>,
         arch: &(impl AsComponents + ?Sized),
     ) -> RecordingStreamResult<()> {
+        let path = path.as_ref();
+        if !self.statics.iter().any(|p| p == path) {
+            self.statics.push(path.to_string());
+        }
         self.rec.log_static(path, arch)
+    }
+
+    /// Every entity given rows so far (without a leading `/`): the temporal ones in the order
+    /// of their first row, then the static ones.
+    pub fn entity_paths(&self) -> Vec<String> {
+        let temporal = self.pending.iter().map(|c| c.path.to_string());
+        let statics = self
+            .statics
+            .iter()
+            .map(|p| p.trim_start_matches('/').to_string());
+        temporal
+            .map(|p| p.trim_start_matches('/').to_string())
+            .chain(statics)
+            .collect()
+    }
+
+    /// Sends a blueprint (a store of its own, built by the caller) to the recording's sink.
+    pub fn send_blueprint(
+        &self,
+        msgs: Vec<rerun::log::LogMsg>,
+        activation: rerun::external::re_log_types::BlueprintActivationCommand,
+    ) {
+        self.rec.send_blueprint(msgs, activation);
+    }
+
+    /// The recording's application id ("sim").
+    pub fn application_id(&self) -> Option<rerun::ApplicationId> {
+        self.rec.store_info().map(|i| i.application_id().clone())
     }
 
     /// Sends the rows gathered for entity `k` (to the chunk thread while it runs).
