@@ -114,6 +114,7 @@ impl ReplayRecorder {
             position_axis: 0.5,
             heading_axis: 0.2,
             drift_axis: 0.5,
+            goal_axis: 1.0,
             time_span: Some([0.0, self.rec.latest_secs()]),
             ..Default::default()
         });

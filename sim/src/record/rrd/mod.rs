@@ -96,6 +96,7 @@ pub struct RrdRecorder {
     pub(super) position_scale: AxisScale,
     heading_scale: AxisScale,
     drift_scale: AxisScale,
+    pub(super) goal_scale: AxisScale,
     /// Per robot (by index): whether its drift series' style was logged.
     drift_styled: Vec<bool>,
 }
@@ -145,6 +146,7 @@ impl RrdRecorder {
             position_scale: AxisScale::default(),
             heading_scale: AxisScale::default(),
             drift_scale: AxisScale::default(),
+            goal_scale: AxisScale::default(),
             drift_styled: Vec::new(),
         };
         r.log_static_world(grid);
@@ -190,6 +192,7 @@ impl RrdRecorder {
             position_axis: self.position_scale.top(0.75, 0.5),
             heading_axis: self.heading_scale.top(0.75, 0.2),
             drift_axis: self.drift_scale.top(1.0, 0.5),
+            goal_axis: self.goal_scale.top(1.0, 1.0),
             time_span: Some([0.0, self.rec.latest_secs()]),
         });
         if let Err(e) = blueprint::send(&self.rec, &layout) {

@@ -6,7 +6,10 @@
 //! - `robots/<name>/goal`: the current goal (a labelled point);
 //! - `robots/<name>/task`: the task status as a text log line whenever it changes, and every
 //!   navigation event (stops, re-plans, giving way, failures) as a text log line with a level;
-//! - `robots/<name>/stops`: a point where the robot stopped for an obstacle.
+//! - `robots/<name>/stops`: a point where the robot stopped for an obstacle;
+//! - `robots/<name>/goal_distance`: the distance left to the current goal along the planned
+//!   path (m; nav2's `distance_remaining`), a series named `<name> to goal`, every
+//!   [`PROGRESS_PERIOD_S`] while the robot has a goal.
 //!
 //! Positions are the robot's BELIEF (what it navigates by), like the planner sees them.
 
@@ -17,12 +20,28 @@ use systems::core::{RobotId, RobotIndex, SimClock};
 use systems::localization::NavBelief;
 use systems::navigation::{Costmap, NavCostmaps, Navigator};
 
+/// Simulated seconds between two values of a robot's distance to its goal.
+pub const PROGRESS_PERIOD_S: f64 = 0.5;
+
 /// What has been logged already.
 #[derive(Resource, Default)]
 pub struct NavRecordState {
     costmap_version: Option<u64>,
     /// Per robot index: (path serial, events logged, last status text).
     robots: Vec<(u64, usize, String)>,
+    /// Per robot index: when its distance to the goal is due next (None before its first).
+    progress_due: Vec<Option<f64>>,
+}
+
+/// The length of `path` from the vertex nearest to `at`, plus the distance to that vertex.
+pub fn distance_remaining(path: &[[f64; 2]], at: [f64; 2]) -> Option<f64> {
+    let d = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+    let (k, first) = path
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (k, d(*p, at)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?;
+    Some(first + path[k..].windows(2).map(|w| d(w[0], w[1])).sum::<f64>())
 }
 
 /// ROS `costmap_2d` publisher translation of a cost byte to an OccupancyGrid value.
@@ -72,8 +91,29 @@ pub fn record_navigation(
         let i = idx.0 as usize;
         if state.robots.len() <= i {
             state.robots.resize(i + 1, (0, 0, String::new()));
+            state.progress_due.resize(i + 1, None);
         }
         let base = format!("robots/{}", id.0);
+        let due = state.progress_due[i];
+        if nav.goal.is_some()
+            && due.is_none_or(|t| now >= t - 1e-9)
+            && let Some(left) = distance_remaining(&nav.path, [belief.pose.x, belief.pose.y])
+        {
+            let path = format!("{base}/goal_distance");
+            if due.is_none() {
+                let res = r.rec.log_static(
+                    path.as_str(),
+                    &rerun::SeriesLines::new()
+                        .with_names([format!("{} to goal", id.0)])
+                        .with_colors([super::colour(idx.0)]),
+                );
+                r.check(res);
+            }
+            state.progress_due[i] = Some(now + PROGRESS_PERIOD_S);
+            r.rec.set_duration_secs("sim_time", now);
+            super::rows::scalar(&mut r.rec, &path, left);
+            r.goal_scale.push(left);
+        }
         let status = nav.status_text();
         let (serial, logged, last) = &mut state.robots[i];
         let changed = *serial != nav.path_serial || *logged < nav.events.len() || *last != status;
@@ -138,5 +178,20 @@ pub fn record_navigation(
             r.check(res);
             *last = status;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_distance_left_runs_along_the_path_from_the_nearest_vertex() {
+        let path = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0]];
+        // beside the second vertex: 1 m to it, then 3 m
+        assert_eq!(distance_remaining(&path, [4.0, -1.0]), Some(4.0));
+        // at the start: the whole path
+        assert_eq!(distance_remaining(&path, [0.0, 0.0]), Some(7.0));
+        assert_eq!(distance_remaining(&[], [0.0, 0.0]), None);
     }
 }

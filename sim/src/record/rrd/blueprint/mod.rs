@@ -11,7 +11,8 @@
 //!   Paths (`…/path`) are sent as new segments only and drawn from the start of the run to the
 //!   time cursor;
 //! - right, one **time-series** view per metric family (position error, heading error,
-//!   odometry drift), every robot's series in it, the y axis from 0 to a bound that the bulk of
+//!   odometry drift, distance left to the goal), every robot's series in it, the y axis from
+//!   0 to a bound that the bulk of
 //!   the run's values fit (a lost localizer's 50 m does not flatten the others' centimetres);
 //!   the camera images of outdoor robots; a **text-log** view of the run's events.
 //!
@@ -129,6 +130,8 @@ pub struct Inputs<'a> {
     pub heading_axis: f64,
     /// Upper end of the odometry-drift axis (m).
     pub drift_axis: f64,
+    /// Upper end of the distance-to-goal axis (m).
+    pub goal_axis: f64,
     /// The run's time span (s): every plot shows all of it.
     pub time_span: Option<[f64; 2]>,
 }
@@ -143,6 +146,7 @@ struct RobotEntities {
     errors: bool,
     heading_errors: bool,
     drift: bool,
+    goal_distance: bool,
     paths: Vec<String>,
     odometry: bool,
 }
@@ -174,6 +178,7 @@ fn robots(paths: &[String]) -> Vec<RobotEntities> {
             ["error", ..] => r.errors = true,
             ["heading_error", ..] => r.heading_errors = true,
             ["odometry", "drift"] => r.drift = true,
+            ["goal_distance"] => r.goal_distance = true,
             ["odometry", ..] => r.odometry = true,
             _ => {}
         }
@@ -285,6 +290,12 @@ pub fn default_layout(inputs: &Inputs) -> Node {
         "Odometry drift (m)",
         family(&|r| r.drift, "odometry/drift"),
         inputs.drift_axis,
+        inputs.time_span,
+    ));
+    right.extend(series_view(
+        "Distance to goal (m)",
+        family(&|r| r.goal_distance, "goal_distance"),
+        inputs.goal_axis,
         inputs.time_span,
     ));
     right.push(Node::View(ViewSpec::new(

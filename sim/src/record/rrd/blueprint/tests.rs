@@ -21,6 +21,7 @@ fn indoor() -> Vec<String> {
         "robots/r1/error/mcl",
         "robots/r1/error/de_filter",
         "robots/r1/heading_error/mcl",
+        "robots/r1/goal_distance",
         "robots/r2/truth",
         "robots/r2/estimate/de_odometry",
         "robots/r2/estimate/de_filter",
@@ -115,6 +116,8 @@ fn each_metric_family_has_its_plot_with_every_robot_that_has_it() {
     assert_eq!(heading.y_range, Some([0.0, 0.3]));
     let drift = view(&root, "Odometry drift (m)");
     assert_eq!(drift.contents, paths(&["/robots/r1/odometry/drift"]));
+    let goal = view(&root, "Distance to goal (m)");
+    assert_eq!(goal.contents, paths(&["/robots/r1/goal_distance"]));
     assert_eq!(view(&root, "Events").class, ViewClass::TextLog);
     // no camera, so no image view
     assert!(!root.views().iter().any(|v| v.class == ViewClass::Spatial2D));
