@@ -124,6 +124,12 @@ pub fn fleet(s: &Summary) -> Row {
             format!("fleet.localization.{n}.ate_rmse_m"),
             json!(figure(&|m| m.ate_rmse_m)),
         ));
+        if ms.iter().any(|m| m.in_map) {
+            out.push((
+                format!("fleet.localization.{n}.ate_map_rmse_m"),
+                json!(figure(&|m| m.ate_map_rmse_m)),
+            ));
+        }
         out.push((
             format!("fleet.localization.{n}.final_error_m"),
             json!(figure(&|m| m.final_error_m)),

@@ -41,6 +41,24 @@ pub struct LocalizerMetrics {
     /// (for graph SLAM, after its last optimization; for filters, the poses they published).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub final_trajectory: Option<TrajectoryMetrics>,
+    /// Whether the estimator localizes in the scenario's map (its error is judged in the map
+    /// frame) rather than integrating odometry or building its own map (judged aligned at the
+    /// first pose). Set by whoever knows the estimator; false by default.
+    #[serde(skip)]
+    pub in_map: bool,
+}
+
+impl LocalizerMetrics {
+    /// The ATE a table shows: the map-frame error for an estimator in the map (aligning its
+    /// first pose would turn a half-degree heading error of the first estimate into
+    /// decimetres), the origin-aligned one for odometry and SLAM [Grupp 2017].
+    pub fn headline_ate(&self) -> Option<f64> {
+        if self.in_map {
+            self.ate_map_rmse_m
+        } else {
+            self.ate_rmse_m
+        }
+    }
 }
 
 /// ATE/RPE of a whole trajectory (same definitions as [`LocalizerMetrics`]).
@@ -109,6 +127,7 @@ impl LocalizerMetrics {
             tracked_fraction: trajectory::tracked_fraction(samples),
             final_error_m: samples.last().map(Sample::position_error),
             final_trajectory: None,
+            in_map: false,
         }
     }
 }

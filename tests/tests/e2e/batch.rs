@@ -69,6 +69,7 @@ fn batch_writes_every_metric_and_is_deterministic_whatever_the_jobs() {
         "fleet.collisions",
         "fleet.distance_m",
         "fleet.localization.mcl.ate_rmse_m",
+        "fleet.localization.mcl.ate_map_rmse_m",
         "robots.r1.distance_m",
         "robots.r4.odometry_drift_m",
         "robots.r1.localization.mcl.ate_rmse_m",
@@ -107,6 +108,7 @@ fn batch_writes_every_metric_and_is_deterministic_whatever_the_jobs() {
         "p95",
         "fleet.distance_m",
         "fleet.localization.mcl.ate_rmse_m",
+        "fleet.localization.mcl.ate_map_rmse_m",
         "real_time_factor",
     ] {
         assert!(r2.table.contains(m), "no {m} in:\n{}", r2.table);

@@ -92,7 +92,22 @@ fn hospital_patrol_runs_every_localizer_type_on_every_robot() {
         // scan-to-scan odometry drifts, but slowly
         let odo = &r.localization["de_odometry"];
         assert!(odo.rpe_trans_m.unwrap() < 0.02, "{}: {odo:?}", r.name);
+        // the table judges localizers in the map in its frame, odometry aligned at its start
+        for (name, m) in &r.localization {
+            let want = if name == "de_odometry" {
+                m.ate_rmse_m
+            } else {
+                m.ate_map_rmse_m
+            };
+            assert_eq!(m.in_map, name != "de_odometry", "{name}");
+            assert_eq!(m.headline_ate(), want, "{name}");
+        }
     }
+    let table = out.summary.table();
+    assert!(
+        table.contains("ATE: in the map frame for localizers in the map"),
+        "{table}"
+    );
 }
 
 /// A robot carried off to another corridor (`kidnap`, at 20 s) is found again by every global

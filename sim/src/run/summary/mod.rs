@@ -232,7 +232,7 @@ impl Summary {
                         r.name,
                         name,
                         m.estimates,
-                        opt(m.ate_rmse_m, 3),
+                        opt(m.headline_ate(), 3),
                         opt(m.rpe_trans_m, 4),
                         opt(m.rpe_rot_rad, 4),
                         opt(m.converged_after_s, 1),
@@ -240,6 +240,8 @@ impl Summary {
                     );
                 }
             }
+            s += "ATE: in the map frame for localizers in the map, aligned at the first pose for \
+                  odometry and SLAM\n";
         }
         s
     }
