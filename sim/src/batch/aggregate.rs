@@ -58,7 +58,8 @@ fn is_metric(col: &str) -> bool {
     !matches!(col, "job" | "set" | "seed" | "status" | "error") && !col.starts_with("set.")
 }
 
-fn number(v: &Json) -> Option<f64> {
+/// A metric's value as a number (booleans as 0/1).
+pub fn number(v: &Json) -> Option<f64> {
     match v {
         Json::Number(n) => n.as_f64(),
         Json::Bool(b) => Some(f64::from(u8::from(*b))),
@@ -66,10 +67,15 @@ fn number(v: &Json) -> Option<f64> {
     }
 }
 
+/// The value of column `k` of a row.
+pub fn column<'a>(r: &'a Row, k: &str) -> Option<&'a Json> {
+    r.iter().find(|(c, _)| c == k).map(|(_, v)| v)
+}
+
 /// Statistics of every set in `0..sets` over `rows` (whose `set` and `status` columns say which
 /// set and whether the run succeeded), metrics in the order of `cols`.
 pub fn aggregate(sets: usize, cols: &[String], rows: &[Row]) -> Vec<SetStats> {
-    let get = |r: &Row, k: &str| r.iter().find(|(c, _)| c == k).map(|(_, v)| v.clone());
+    let get = |r: &Row, k: &str| column(r, k).cloned();
     (0..sets)
         .filter_map(|set| {
             let mine: Vec<&Row> = rows

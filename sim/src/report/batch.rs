@@ -3,23 +3,10 @@
 
 use super::figures;
 use super::page::{self, escape, number};
-use crate::batch::aggregate::SetStats;
+use crate::batch::aggregate::{self, SetStats};
 use crate::batch::output::{Row, cell};
 use serde_json::Value as Json;
 use std::fmt::Write as _;
-
-/// The value of column `k` of a row.
-fn get<'a>(r: &'a Row, k: &str) -> Option<&'a Json> {
-    r.iter().find(|(c, _)| c == k).map(|(_, v)| v)
-}
-
-fn as_number(v: &Json) -> Option<f64> {
-    match v {
-        Json::Number(n) => n.as_f64(),
-        Json::Bool(b) => Some(f64::from(u8::from(*b))),
-        _ => None,
-    }
-}
 
 /// A set's parameters as `key=value` (those that differ between sets).
 fn set_label(st: &SetStats, stats: &[SetStats]) -> String {
@@ -30,7 +17,7 @@ fn set_label(st: &SetStats, stats: &[SetStats]) -> String {
 pub fn batch_page(name: &str, rows: &[Row], stats: &[SetStats]) -> anyhow::Result<String> {
     let ok = rows
         .iter()
-        .filter(|r| get(r, "status").and_then(Json::as_str) == Some("ok"))
+        .filter(|r| aggregate::column(r, "status").and_then(Json::as_str) == Some("ok"))
         .count();
     let mut html = page::start(&format!("batch {name}"));
     let _ = writeln!(
@@ -112,7 +99,7 @@ pub fn batch_page(name: &str, rows: &[Row], stats: &[SetStats]) -> anyhow::Resul
     html.push_str("<div class=\"grid\">\n");
     let ok_rows: Vec<&Row> = rows
         .iter()
-        .filter(|r| get(r, "status").and_then(Json::as_str) == Some("ok"))
+        .filter(|r| aggregate::column(r, "status").and_then(Json::as_str) == Some("ok"))
         .collect();
     for m in &metrics {
         let sets: Vec<(String, Vec<f64>)> = stats
@@ -120,8 +107,10 @@ pub fn batch_page(name: &str, rows: &[Row], stats: &[SetStats]) -> anyhow::Resul
             .map(|st| {
                 let values = ok_rows
                     .iter()
-                    .filter(|r| get(r, "set").and_then(Json::as_u64) == Some(st.set as u64))
-                    .filter_map(|r| get(r, m).and_then(as_number))
+                    .filter(|r| {
+                        aggregate::column(r, "set").and_then(Json::as_u64) == Some(st.set as u64)
+                    })
+                    .filter_map(|r| aggregate::column(r, m).and_then(aggregate::number))
                     .filter(|v| v.is_finite())
                     .collect();
                 (format!("set {}", st.set), values)

@@ -29,8 +29,11 @@ fn extent(map: Option<&MapCells>, roads: &[RoadLine], robots: &[RobotTrace]) -> 
         f64::NEG_INFINITY,
         f64::NEG_INFINITY,
     ];
+    // a report.json edited by hand may hold anything: non-finite points are left out
     let mut add = |x: f64, y: f64| {
-        b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+        if x.is_finite() && y.is_finite() {
+            b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+        }
     };
     if let Some(m) = map {
         add(m.origin[0], m.origin[1]);

@@ -225,14 +225,14 @@ pub fn run_page(r: &RunReport) -> anyhow::Result<String> {
         }
     }
 
-    let nav_rows: Vec<(String, &Map<String, Json>)> = robots
-        .iter()
-        .filter_map(|m| {
-            m.get("navigation")
-                .and_then(Json::as_object)
-                .map(|n| (name(m), n))
-        })
-        .collect();
+    // the robots that have a section `key` (navigation, road), labelled with their names
+    let section = |key: &str| -> Vec<(String, &Map<String, Json>)> {
+        robots
+            .iter()
+            .filter_map(|m| m.get(key).and_then(Json::as_object).map(|n| (name(m), n)))
+            .collect()
+    };
+    let nav_rows = section("navigation");
     if !nav_rows.is_empty() {
         page.push_str("<h2>Navigation</h2>\n");
         let svg = figures::timeline_figure(&r.robots, f("sim_time_s"))?;
@@ -268,14 +268,7 @@ pub fn run_page(r: &RunReport) -> anyhow::Result<String> {
         }
     }
 
-    let road_rows: Vec<(String, &Map<String, Json>)> = robots
-        .iter()
-        .filter_map(|m| {
-            m.get("road")
-                .and_then(Json::as_object)
-                .map(|n| (name(m), n))
-        })
-        .collect();
+    let road_rows = section("road");
     if !road_rows.is_empty() {
         page.push_str("<h2>Outdoor drive</h2>\n");
         table(&mut page, "robot", &road_rows);

@@ -219,3 +219,44 @@ fn a_batch_page_has_the_sets_the_aggregate_and_a_box_per_varying_metric() {
     assert_eq!(again.matches("<svg").count(), 1);
     assert!(again.contains("1 failed"));
 }
+
+/// A report.json edited by hand with odd data (far-off and inverted values, an empty map, a
+/// summary without its fields) still gives a page: figures clip, nothing panics.
+#[test]
+fn odd_report_data_draws_a_page_without_panicking() {
+    let r = RunReport {
+        format: FORMAT.into(),
+        summary: json!({"robots": [{"name": "r1", "navigation": {"tasks": 1}}]}),
+        map: Some(MapCells {
+            origin: [0.0, 0.0],
+            resolution: 0.0,
+            size: [0, 0],
+            occupied: vec![[3, 9, 2]],
+        }),
+        roads: vec![RoadLine {
+            width: -1.0,
+            points: vec![[1e30, 0.0]],
+        }],
+        robots: vec![RobotTrace {
+            name: "r1".into(),
+            truth: vec![vec![[0.0, 0.0], [f32::MAX, 1.0]]],
+            localizers: vec![LocalizerTrace {
+                name: "mcl".into(),
+                path: vec![],
+                error: vec![[0.0, 1e300], [5.0, -3.0]],
+            }],
+            tasks: vec![TaskSpan {
+                task: "<b>".into(),
+                start: 9.0,
+                end: 2.0,
+                outcome: Outcome::Failed,
+            }],
+        }],
+    };
+    let html = page::run_page(&r).unwrap();
+    assert_self_contained(&html);
+    assert!(
+        html.contains("&lt;b&gt;") && !html.contains("<b>"),
+        "names are escaped"
+    );
+}

@@ -167,6 +167,10 @@ impl MapLocalizer for DeOdometry {
         "de_odometry"
     }
 
+    fn localizes_in_map(&self) -> bool {
+        false
+    }
+
     fn max_beams(&self) -> usize {
         self.config.max_beams
     }

@@ -40,6 +40,12 @@ pub trait MapLocalizer: Send + Sync + Debug {
     fn belief_points(&self) -> Option<Vec<([f64; 2], f64)>> {
         None
     }
+    /// Whether its estimates are poses in the map (true by default): its error is then judged
+    /// in the map frame. False for one that integrates motion from its start pose and reads
+    /// the map not at all (scan-to-scan odometry), judged aligned at its first pose.
+    fn localizes_in_map(&self) -> bool {
+        true
+    }
     fn box_clone(&self) -> Box<dyn MapLocalizer>;
     /// For the recorder and the experiments, which know our concrete types.
     fn as_any(&self) -> &dyn Any;

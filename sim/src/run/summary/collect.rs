@@ -44,11 +44,7 @@ pub(crate) fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
                             .find(|(n, _)| *n == l.name)
                             .map_or(&[][..], |(_, s)| &s[..]);
                         let mut m = LocalizerMetrics::from_samples(l.filter.kind(), s);
-                        // DE odometry is a map localizer that does not use the map
-                        m.in_map = l.filter.as_map().is_some_and(|f| {
-                            f.downcast_ref::<systems::localization::de_odometry::DeOdometry>()
-                                .is_none()
-                        });
+                        m.in_map = l.filter.as_map().is_some_and(|f| f.localizes_in_map());
                         if let Filter::Scan(e) = &l.filter {
                             let paired = pair_with_truth(s, &e.trajectory());
                             m.final_trajectory = Some(TrajectoryMetrics::from_samples(&paired));
