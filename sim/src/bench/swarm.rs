@@ -197,6 +197,7 @@ pub fn swarm_scenario(
             footprint: Footprint::Circle { radius: 0.25 },
             kinematics: Kinematics::DiffDrive(default_diff_drive()),
             behaviour: BehaviourKind::Wander,
+            behaviour_localizer: None,
             speed: 0.8,
             tolerance: 0.4,
             laser: Some(swarm_laser(beams)),

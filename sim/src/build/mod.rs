@@ -267,6 +267,9 @@ pub fn build_world_with(
                 ent.insert(NavSource::new(l));
             }
         }
+        if let (None, Some(l)) = (&r.navigation, r.behaviour_localizer) {
+            world.entity_mut(e).insert(NavSource::new(l));
+        }
         robots.push(e);
     }
     times.lap("robots and their localizers");
@@ -382,11 +385,10 @@ fn spawn_robot(
     body: systems::body::PhysicsBody,
     localizers: Vec<Localizer>,
 ) -> anyhow::Result<Entity> {
-    let half_width = r.footprint.bounding_radius() + 0.1;
     let mut behaviour = Behaviour::new(
         r.behaviour.clone(),
         r.speed,
-        half_width,
+        r.footprint.bounding_radius(),
         stream_rng(seed, &r.name, "behaviour"),
     );
     behaviour.tolerance = r.tolerance;

@@ -55,7 +55,14 @@ impl TruthTrack {
     pub fn samples(&self, estimates: &[(f64, Pose2)]) -> Vec<Sample> {
         estimates
             .iter()
-            .filter_map(|&(t, estimate)| self.at(t).map(|truth| Sample { t, estimate, truth }))
+            .filter_map(|&(t, estimate)| {
+                self.at(t).map(|truth| Sample {
+                    t,
+                    estimate,
+                    truth,
+                    spread_m: 0.0,
+                })
+            })
             .collect()
     }
 

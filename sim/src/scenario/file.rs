@@ -205,6 +205,8 @@ pub struct BehaviourFile {
     pub looping: Option<bool>,
     pub speed: Option<f64>,
     pub tolerance: Option<f64>,
+    /// Navigate by this localizer instead of the wheel odometry.
+    pub localizer: Option<String>,
 }
 
 /// `[robots.sensors]`: each sensor the robot has, each over its preset.

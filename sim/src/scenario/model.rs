@@ -91,6 +91,8 @@ pub struct RobotConfig {
     pub footprint: Footprint,
     pub kinematics: Kinematics,
     pub behaviour: BehaviourKind,
+    /// Index of the localizer the behaviour drives by (None: wheel odometry).
+    pub behaviour_localizer: Option<usize>,
     pub speed: f64,
     pub tolerance: f64,
     pub laser: Option<LaserSpec>,

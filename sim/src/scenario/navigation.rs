@@ -5,7 +5,7 @@
 use super::check::PointOrPlace;
 use super::check::{Checker, R};
 use super::error::KeyPath;
-use super::localizers::LocalizerConfig;
+use super::localizers::{LocalizerConfig, localizer_index};
 use serde::Deserialize;
 use systems::body::{Footprint, Kinematics};
 use systems::core::Pose2;
@@ -171,23 +171,11 @@ pub(super) fn resolve_navigation(
             max_steer: a.max_steer,
         },
     };
-    let localizer = match &n.localizer {
-        None => None,
-        Some(name) => match robot.localizers.iter().position(|l| &l.name == name) {
-            Some(i) => Some(i),
-            None => {
-                let known: Vec<&str> = robot.localizers.iter().map(|l| l.name.as_str()).collect();
-                return c.err(
-                    &np.key("localizer"),
-                    if known.is_empty() {
-                        format!("no localizer named `{name}`: the robot has no `[[robots.localization]]`")
-                    } else {
-                        format!("no localizer named `{name}`; the robot has: {}", known.join(", "))
-                    },
-                );
-            }
-        },
-    };
+    let localizer = n
+        .localizer
+        .as_deref()
+        .map(|name| localizer_index(c, &np.key("localizer"), name, robot.localizers))
+        .transpose()?;
     let mut out = Vec::new();
     for (i, t) in tasks.iter().enumerate() {
         let tp = robot_path.key("tasks").index(i);

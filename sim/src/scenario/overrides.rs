@@ -217,6 +217,15 @@ fn item_index(
     Ok(i)
 }
 
+/// Whether `step` is the index one past the end of an array of `len` items (which adds one).
+fn appends(step: &Step, len: usize) -> bool {
+    match step {
+        Step::Index(i) => *i == len,
+        Step::Key(k) => k.parse::<usize>().is_ok_and(|i| i == len),
+        Step::Select { .. } => false,
+    }
+}
+
 fn scalar_text(v: Option<&Value>) -> Option<String> {
     match v? {
         Value::String(s) => Some(s.value().clone()),
@@ -230,6 +239,26 @@ fn set_in_item(item: &mut Item, steps: &[Step], v: Value, at: &mut String) -> Re
         Item::Table(t) => set_in_table(t, steps, v, at),
         Item::ArrayOfTables(a) => {
             let len = a.len();
+            if appends(&steps[0], len) {
+                // one past the end: a new item, the whole table or its first key
+                a.push(toml_edit::Table::new());
+                at.push_str(&format!("[{len}]"));
+                let t = a.get_mut(len).ok_or_else(|| format!("`{at}` is missing"))?;
+                return match (&steps[1..], v) {
+                    ([], Value::InlineTable(it)) => {
+                        for (k, item) in it.iter() {
+                            t.insert(k, Item::Value(item.clone()));
+                        }
+                        Ok(())
+                    }
+                    ([], other) => Err(format!(
+                        "`{at}` adds an item to an array of tables: give a table \
+                         ({at}={{type=\"..\", ..}}), not {}",
+                        value_kind(&other)
+                    )),
+                    (rest, v) => set_in_table(t, rest, v, at),
+                };
+            }
             let i = item_index(&steps[0], len, at, |i, key| {
                 scalar_text(a.get(i)?.get(key)?.as_value())
             })?;
@@ -254,6 +283,11 @@ fn set_in_value(val: &mut Value, steps: &[Step], v: Value, at: &mut String) -> R
         Value::InlineTable(t) => set_in_table(t, steps, v, at),
         Value::Array(a) => {
             let len = a.len();
+            if appends(&steps[0], len) && steps.len() == 1 {
+                at.push_str(&format!("[{len}]"));
+                a.push_formatted(v);
+                return Ok(());
+            }
             let i = item_index(&steps[0], len, at, |i, key| {
                 scalar_text(a.get(i)?.as_inline_table()?.get(key))
             })?;

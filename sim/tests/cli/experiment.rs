@@ -102,3 +102,47 @@ fn de_match_refuses_too_many_pairs_before_capturing() {
         expect_failure(args, dir.path(), &["--pairs: expected 1 to 10000 pairs"]);
     }
 }
+
+#[test]
+fn localization_refuses_bad_seeds_sets_and_scenarios_before_simulating() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&[&str], &[&str]); 6] = [
+        (&["--seeds", "5..5"], &["--seeds 5..5", "empty"]),
+        (
+            &["--seeds", "0..200000"],
+            &["--seeds 0..200000", "at most 100000"],
+        ),
+        (&["--duration", "0"], &["--duration", "positive"]),
+        (
+            &["--set", "robots.0.localization.0.max_particles=0"],
+            &["--set robots.0.localization.0.max_particles=0"],
+        ),
+        (
+            &["--set", "robots.0.localization.9={type=\"mcl\"}"],
+            &["robots[0].localization", "index 9 is out of range"],
+        ),
+        (&["--scenario", "no_such_world"], &["no_such_world"]),
+    ];
+    for (extra, want) in cases {
+        let mut args = vec!["experiment", "localization"];
+        args.extend(extra);
+        expect_failure(&args, dir.path(), want);
+    }
+}
+
+#[test]
+fn localization_refuses_a_scenario_without_localizers() {
+    let dir = tempfile::tempdir().unwrap();
+    expect_failure(
+        &[
+            "experiment",
+            "localization",
+            "--scenario",
+            "park_route_short",
+            "--seeds",
+            "0..1",
+        ],
+        dir.path(),
+        &["park_route_short", "no robot has a localizer"],
+    );
+}

@@ -98,6 +98,7 @@ pub fn pair_with_truth(
                 t,
                 estimate: pose,
                 truth: s.truth,
+                spread_m: 0.0,
             })
         })
         .collect()
@@ -153,6 +154,7 @@ pub fn sample_localization(
                     t: e.stamp,
                     estimate: e.estimate.pose,
                     truth: truth.interpolate(f),
+                    spread_m: e.estimate.position_spread(),
                 });
             }
         }

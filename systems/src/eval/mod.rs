@@ -5,6 +5,7 @@ pub mod localization_metrics;
 pub mod navigation_metrics;
 pub mod road_metrics;
 pub mod robot_metrics;
+pub mod tracking;
 pub mod trajectory;
 
 pub use localization_metrics::{
@@ -12,6 +13,7 @@ pub use localization_metrics::{
 };
 pub use navigation_metrics::NavOutcome;
 pub use robot_metrics::RobotMetrics;
+pub use tracking::{LostEpisode, TrackingRecord, tracking_record};
 pub use trajectory::Sample;
 
 use crate::core::{Chained, SimPlugin, SimSet, any_with};

@@ -25,6 +25,9 @@ pub struct Sample {
     pub t: f64,
     pub estimate: Pose2,
     pub truth: Pose2,
+    /// The position spread the estimator reported with it, √(σ²ₓ + σ²ᵧ) (m); 0 when it reports
+    /// none. How a localizer says it is unsure: it is never compared with the truth.
+    pub spread_m: f64,
 }
 
 impl Sample {
@@ -115,6 +118,7 @@ mod tests {
             t,
             estimate: Pose2::new(e.0, e.1, e.2),
             truth: Pose2::new(g.0, g.1, g.2),
+            spread_m: 0.0,
         }
     }
 

@@ -24,9 +24,18 @@ pub enum RangeMetric {
 /// Members per parallel work item.
 const CHUNK: usize = 16;
 
+/// A beam whose range differs from the expected one by more than this (m) counts as this much:
+/// it saw something the map does not hold (a person, a trolley) or the pose is wrong there,
+/// and either way its size says nothing more. Without the cap, the few metres by which a person
+/// in front shortens a dozen beams outweighed the rest of the scan, and the best pose slid along
+/// a corridor towards the person, then jumped to the corridor's mirror image (a truncated
+/// M-estimator; the beam model's short and random readings [Thrun 2005, §6.3]).
+pub const RANGE_OUTLIER_M: f32 = 1.0;
+
 /// Cost of each pose `(xs[i], ys[i], ths[i])` for the scan `beams`: the mean over beams of
-/// |z − ẑ| (L1) or (z − ẑ)² (L2), both ranges capped at the scan's maximum. Ray casting on
-/// `map.rays`, members in parallel chunks (results do not depend on threads).
+/// min(|z − ẑ|, c) (L1) or min((z − ẑ)², c²) (L2), c = [`RANGE_OUTLIER_M`], both ranges capped
+/// at the scan's maximum. Ray casting on `map.rays`, members in parallel chunks (results do not
+/// depend on threads).
 pub fn range_costs(
     map: &LocalizationMap,
     beams: &BeamSubset,
@@ -58,9 +67,9 @@ pub fn range_costs(
             for (o, expected) in oc.iter_mut().zip(all.chunks_exact(m)) {
                 let mut sum = 0.0f64;
                 for (z, zs) in beams.ranges.iter().zip(expected) {
-                    let d = (z.min(rmax) - zs.min(rmax)) as f64;
+                    let d = (z.min(rmax) - zs.min(rmax)).abs().min(RANGE_OUTLIER_M) as f64;
                     sum += match metric {
-                        RangeMetric::L1 => d.abs(),
+                        RangeMetric::L1 => d,
                         RangeMetric::L2 => d * d,
                     };
                 }

@@ -32,7 +32,7 @@ fn a_robot_from_the_bundle_drives_where_it_is_told() {
     let idle = Behaviour::new(
         BehaviourKind::Idle,
         0.5,
-        0.3,
+        0.2,
         stream_rng(1, "r1", "behaviour"),
     );
     let robot = world

@@ -96,6 +96,7 @@ mod tests {
                 t,
                 estimate: Pose2::new(e, 0.0, 0.0),
                 truth: Pose2::new(0.0, 0.0, 0.0),
+                spread_m: 0.0,
             };
             if let Some(c) = status.update(&s) {
                 out.push((t, c));

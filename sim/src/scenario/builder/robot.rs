@@ -143,6 +143,12 @@ impl RobotBuilder {
         self
     }
 
+    /// Drive the behaviour by this localizer (its name) instead of the wheel odometry.
+    pub fn behaviour_localizer(mut self, name: impl Into<String>) -> Self {
+        self.behaviour_mut().localizer = Some(name.into());
+        self
+    }
+
     fn sensors(&mut self) -> &mut SensorsFile {
         self.file.sensors.get_or_insert_with(Default::default)
     }

@@ -384,6 +384,44 @@ fn an_unknown_localizer_type_is_the_files_error() {
 }
 
 #[test]
+fn a_behaviour_driving_by_an_unknown_localizer_is_the_files_error() {
+    let (built, file) = bad(
+        "[robots.sensors.laser]\n[robots.sensors.encoder]\n[robots.behaviour]\n\
+         type = \"waypoints\"\npoints = [\"home\"]\nlocalizer = \"amcl\"\n\
+         [[robots.localization]]\ntype = \"mcl\"\n",
+        robot()
+            .laser(LaserFile::default())
+            .encoder(EncoderFile::default())
+            .waypoints(["home"], false)
+            .behaviour_localizer("amcl")
+            .localizer_type("mcl"),
+    );
+    same_error(&built, &file, "robots[0].behaviour.localizer");
+    assert!(
+        built
+            .message
+            .contains("no localizer named `amcl`; the robot has: mcl"),
+        "{built}"
+    );
+    // an idle robot has nothing to drive by it
+    let (built, file) = bad(
+        "[robots.sensors.laser]\n[robots.sensors.encoder]\n[robots.behaviour]\n\
+         type = \"idle\"\nlocalizer = \"mcl\"\n[[robots.localization]]\ntype = \"mcl\"\n",
+        robot()
+            .laser(LaserFile::default())
+            .encoder(EncoderFile::default())
+            .idle()
+            .behaviour_localizer("mcl")
+            .localizer_type("mcl"),
+    );
+    same_error(&built, &file, "robots[0].behaviour.localizer");
+    assert!(
+        built.message.contains("`idle` robot does not move"),
+        "{built}"
+    );
+}
+
+#[test]
 fn a_place_given_twice_is_an_error() {
     let e = hospital_built()
         .place("pharmacy", [3.0, 13.0, 0.0])

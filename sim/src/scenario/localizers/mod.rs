@@ -350,6 +350,31 @@ impl LocalizerFile {
     }
 }
 
+/// The index of the localizer called `name` among a robot's, for a key that names the one to
+/// navigate by; an error naming `key` and the robot's localizers otherwise.
+pub(in crate::scenario) fn localizer_index(
+    c: &Checker,
+    key: &KeyPath,
+    name: &str,
+    localizers: &[LocalizerConfig],
+) -> R<usize> {
+    if let Some(i) = localizers.iter().position(|l| l.name == name) {
+        return Ok(i);
+    }
+    let known: Vec<&str> = localizers.iter().map(|l| l.name.as_str()).collect();
+    c.err(
+        key,
+        if known.is_empty() {
+            format!("no localizer named `{name}`: the robot has no `[[robots.localization]]`")
+        } else {
+            format!(
+                "no localizer named `{name}`; the robot has: {}",
+                known.join(", ")
+            )
+        },
+    )
+}
+
 /// A validated localizer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LocalizerConfig {
@@ -373,6 +398,26 @@ pub enum LocalizerKind {
 }
 
 impl LocalizerConfig {
+    /// How it starts: None for an estimator that does not localize in the map (DE odometry,
+    /// SLAM), else whether its first belief covers the whole map (global localization) or a
+    /// known pose.
+    pub fn starts_global(&self) -> Option<bool> {
+        let init = match &self.kind {
+            LocalizerKind::Mcl(m) => m.init,
+            LocalizerKind::MarkovGrid(m) => m.init,
+            LocalizerKind::DeFilter(m) => m.init,
+            LocalizerKind::DeMc(m) => m.init,
+            LocalizerKind::DeOdometry(_)
+            | LocalizerKind::ScanToMap(_)
+            | LocalizerKind::Graph(_)
+            | LocalizerKind::Rbpf(_) => return None,
+        };
+        Some(matches!(
+            init,
+            systems::localization::mcl::InitialBelief::Global
+        ))
+    }
+
     /// The distance-field truncation this localizer needs (m), if it uses the field.
     pub fn field_max_dist(&self) -> Option<f64> {
         match &self.kind {

@@ -100,6 +100,33 @@ fn applies_in_place() {
 }
 
 #[test]
+fn an_index_one_past_the_end_adds_an_item() {
+    // a whole localizer as a table, then a key of a new robot, then an inline-array value
+    let mut doc: DocumentMut = DOC.parse().unwrap();
+    for (k, v) in [
+        (
+            "robots.0.localization.1",
+            "{ type = \"de_mc\", init = \"global\" }",
+        ),
+        ("robots[2].name", "r3"),
+        ("robots.0.localization.0.alpha.2", "0.3"),
+    ] {
+        Override::new("--set", k, v)
+            .unwrap()
+            .apply(&mut doc)
+            .unwrap();
+    }
+    let text = doc.to_string();
+    let doc: DocumentMut = text.parse().unwrap();
+    let l = &doc["robots"][0]["localization"];
+    assert_eq!(l[0]["type"].as_str(), Some("mcl"), "{text}");
+    assert_eq!(l[1]["type"].as_str(), Some("de_mc"), "{text}");
+    assert_eq!(l[1]["init"].as_str(), Some("global"), "{text}");
+    assert_eq!(l[0]["alpha"].as_array().map(|a| a.len()), Some(3), "{text}");
+    assert_eq!(doc["robots"][2]["name"].as_str(), Some("r3"), "{text}");
+}
+
+#[test]
 fn structural_errors() {
     for (k, want) in [
         (
@@ -113,6 +140,11 @@ fn structural_errors() {
         ("robots.speed", "`robots` is an array: select an item"),
         ("duration.x", "`duration` is a number, not a table"),
         ("robots.0", "is a whole table"),
+        (
+            "robots.2",
+            "adds an item to an array of tables: give a table",
+        ),
+        ("robots.0.localization.0.alpha.3", "index 3 is out of range"),
     ] {
         let e = set(k, "1").unwrap_err().to_string();
         assert!(e.starts_with(&format!("--set {k}=1: ")), "{e}");

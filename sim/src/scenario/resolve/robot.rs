@@ -137,6 +137,21 @@ pub(super) fn resolve_robot(
             );
         }
     }
+    let behaviour_localizer = match r.behaviour.as_ref().and_then(|b| b.localizer.as_deref()) {
+        None => None,
+        Some(_) if matches!(behaviour, BehaviourKind::Idle) => {
+            return c.err(
+                &bp.key("localizer"),
+                "an `idle` robot does not move: only `waypoints` and `wander` drive by a localizer",
+            );
+        }
+        Some(name) => Some(crate::scenario::localizers::localizer_index(
+            c,
+            &bp.key("localizer"),
+            name,
+            &localizers,
+        )?),
+    };
     if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
         return c.err(
             &bp.key("type"),
@@ -149,6 +164,7 @@ pub(super) fn resolve_robot(
         footprint,
         kinematics,
         behaviour,
+        behaviour_localizer,
         speed,
         tolerance,
         laser,

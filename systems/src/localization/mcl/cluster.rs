@@ -17,6 +17,19 @@ pub struct PoseEstimate {
     pub weight: f64,
 }
 
+impl PoseEstimate {
+    /// √(σ²ₓ + σ²ᵧ) (m): how far the estimator thinks it may be off; 0 for a covariance that is
+    /// not finite or not positive.
+    pub fn position_spread(&self) -> f64 {
+        let v = self.covariance[0][0] + self.covariance[1][1];
+        if v.is_finite() && v > 0.0 {
+            v.sqrt()
+        } else {
+            0.0
+        }
+    }
+}
+
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];

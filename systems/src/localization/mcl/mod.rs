@@ -144,6 +144,28 @@ impl MclConfig {
 /// The heaviest particles a challenge compares the scan proposal with.
 const CHALLENGE_TOP: usize = 256;
 
+/// The best poses of a challenge kept as its contender.
+const CONTENDER_POSES: usize = 32;
+
+/// Updates in a row a contender must explain the scan better than the filter before particles
+/// are drawn from it. One scan cannot tell a place from its look-alike (the hospital's wards
+/// repeat every 5.85 m and its wings every 27 m): a single better fit there, from a person in
+/// view or the noise, pulled a filter that was tracking onto the look-alike. A contender that
+/// keeps winning as the robot moves on is a different matter: the filter is at the wrong place.
+pub const CONTENDER_WINS: u32 = 4;
+
+/// The estimate's position spread (m) under which the filter counts as settled on a place.
+pub const SETTLED_SPREAD_M: f64 = 0.5;
+
+/// A challenger followed over updates: its poses move with the odometry (noise-free).
+#[derive(Clone, Debug)]
+struct Contender {
+    poses: Vec<(f64, f64, f64)>,
+    /// The odometry pose they were last moved to.
+    odom: Pose2,
+    wins: u32,
+}
+
 /// Particles per motion-sampling work item (each seeded from the filter's stream in order).
 const MOTION_CHUNK: usize = 1024;
 
@@ -167,6 +189,9 @@ pub struct Mcl {
     pub updates: u64,
     /// Resamplings done.
     pub resamplings: u64,
+    /// A place the scan proposal found to explain a scan better than the filter, followed
+    /// until it has done so for [`CONTENDER_WINS`] updates in a row (or dropped).
+    contender: Option<Contender>,
     /// The dominant cluster's estimate, computed when first asked for: a global filter's
     /// first cloud covers the whole floor (100 000 particles take tens of milliseconds), and
     /// its first update usually comes before anyone asks.
@@ -206,6 +231,7 @@ impl Mcl {
             table: None,
             updates: 0,
             resamplings: 0,
+            contender: None,
             estimate: OnceLock::new(),
         }
     }
@@ -333,8 +359,66 @@ impl Mcl {
         (!pool.is_empty()).then_some(pool)
     }
 
-    /// The scan proposal when it explains the scan markedly better than the filter's best
-    /// particle (see [`MclConfig::challenge_every`]); checked every `challenge_every` updates.
+    /// The poses among `candidates` that explain the scan at least `challenge_ratio` times
+    /// better than the filter's best explanation of it (the best of its heaviest particles),
+    /// best first.
+    fn better_than_filter(
+        &self,
+        map: &LocalizationMap,
+        table: &[f32; 256],
+        points: &[[f32; 2]],
+        candidates: &[(f64, f64, f64)],
+    ) -> Vec<(f64, f64, f64)> {
+        let mut top: Vec<usize> = (0..self.len()).collect();
+        let k = CHALLENGE_TOP.min(top.len());
+        if k == 0 || candidates.is_empty() {
+            return Vec::new();
+        }
+        top.select_nth_unstable_by(k - 1, |&a, &b| {
+            self.w[b].total_cmp(&self.w[a]).then(a.cmp(&b))
+        });
+        top.truncate(k);
+        let m = candidates.len();
+        let pick = |own: &[f64], get: fn(&(f64, f64, f64)) -> f64| -> Vec<f64> {
+            candidates
+                .iter()
+                .map(get)
+                .chain(top.iter().map(|&i| own[i]))
+                .collect()
+        };
+        let xs = pick(&self.xs, |p| p.0);
+        let ys = pick(&self.ys, |p| p.1);
+        let ths = pick(&self.ths, |p| p.2);
+        let mut score = vec![1.0f64; xs.len()];
+        sensor_model::weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+        let own = score[m..].iter().copied().fold(f64::MIN_POSITIVE, f64::max);
+        let bar = own * self.config.challenge_ratio;
+        let mut better: Vec<(f64, (f64, f64, f64))> = candidates
+            .iter()
+            .zip(&score[..m])
+            .filter(|&(_, &s)| s >= bar)
+            .map(|(p, &s)| (s, *p))
+            .collect();
+        better.sort_by(|a, b| b.0.total_cmp(&a.0));
+        better.into_iter().map(|(_, p)| p).collect()
+    }
+
+    /// Wins in a row a contender needs: one while the filter has not settled on a place (its
+    /// estimate's spread is over [`SETTLED_SPREAD_M`], as during global localization), so the
+    /// search is not slowed; [`CONTENDER_WINS`] once it has.
+    fn wins_needed(&self) -> u32 {
+        match self.estimate() {
+            Some(e) if e.position_spread() <= SETTLED_SPREAD_M => CONTENDER_WINS,
+            _ => 1,
+        }
+    }
+
+    /// The challenge of [`MclConfig::challenge_every`] as a sequential test: every
+    /// `challenge_every` updates (while no contender is followed) the scan proposal looks for
+    /// poses that explain the scan markedly better than the filter; the best become the
+    /// contender, which moves with the odometry and must win again at each following update.
+    /// After [`CONTENDER_WINS`] wins in a row its poses are the pool particles are drawn from;
+    /// one loss drops it.
     fn challenge(
         &mut self,
         map: &LocalizationMap,
@@ -342,11 +426,38 @@ impl Mcl {
     ) -> Option<Vec<(f64, f64, f64)>> {
         let every = self.config.challenge_every;
         let n = self.config.injection_candidates;
-        if every == 0 || n == 0 || beams.is_empty() || self.updates % every != every - 1 {
+        let odom = self.last_odom?;
+        if every == 0 || n == 0 || beams.is_empty() {
             return None;
         }
         let table = self.field_table(map, beams.range_max);
         let points = beams.returns();
+        if let Some(mut c) = self.contender.take() {
+            let step = c.odom.between(&odom);
+            let moved: Vec<(f64, f64, f64)> = c
+                .poses
+                .iter()
+                .map(|&(x, y, th)| {
+                    let p = Pose2::new(x, y, th).compose(&step);
+                    (p.x, p.y, p.theta)
+                })
+                .collect();
+            let better = self.better_than_filter(map, &table, &points, &moved);
+            if better.is_empty() {
+                return None; // the filter explains this scan as well: dropped
+            }
+            c.wins += 1;
+            if c.wins >= self.wins_needed() {
+                return Some(better);
+            }
+            c.poses = better;
+            c.odom = odom;
+            self.contender = Some(c);
+            return None;
+        }
+        if self.updates % every != every - 1 {
+            return None;
+        }
         let pool = injection::scan_proposal(
             map,
             &self.config.laser,
@@ -356,39 +467,19 @@ impl Mcl {
             n,
             &mut self.rng,
         );
-        // the filter's best explanation of this scan: the best of its heaviest particles
-        let mut top: Vec<usize> = (0..self.len()).collect();
-        let k = CHALLENGE_TOP.min(top.len());
-        if k == 0 {
-            return None;
+        let mut better = self.better_than_filter(map, &table, &points, &pool);
+        if !better.is_empty() && self.wins_needed() <= 1 {
+            return Some(better);
         }
-        top.select_nth_unstable_by(k - 1, |&a, &b| {
-            self.w[b].total_cmp(&self.w[a]).then(a.cmp(&b))
-        });
-        top.truncate(k);
-        let m = pool.len();
-        let pick = |own: &[f64], get: fn(&(f64, f64, f64)) -> f64| -> Vec<f64> {
-            pool.iter()
-                .map(get)
-                .chain(top.iter().map(|&i| own[i]))
-                .collect()
-        };
-        let xs = pick(&self.xs, |p| p.0);
-        let ys = pick(&self.ys, |p| p.1);
-        let ths = pick(&self.ths, |p| p.2);
-        let mut score = vec![1.0f64; xs.len()];
-        sensor_model::weigh_likelihood_field(
-            &map.field, &table, &points, &xs, &ys, &ths, &mut score,
-        );
-        let own = score[m..].iter().copied().fold(f64::MIN_POSITIVE, f64::max);
-        let bar = own * self.config.challenge_ratio;
-        let challengers: Vec<(f64, f64, f64)> = pool
-            .iter()
-            .zip(&score[..m])
-            .filter(|&(_, &s)| s >= bar)
-            .map(|(p, _)| *p)
-            .collect();
-        (!challengers.is_empty()).then_some(challengers)
+        better.truncate(CONTENDER_POSES);
+        if !better.is_empty() {
+            self.contender = Some(Contender {
+                poses: better,
+                odom,
+                wins: 1,
+            });
+        }
+        None
     }
 
     fn resample(
