@@ -3,6 +3,7 @@
 //! both steering around obstacles seen by the laser ([`super::avoid`]).
 
 use super::avoid::SectorRanges;
+use super::collision_guard::{CONTACT_MARGIN, guarded_speed};
 use crate::body::{DriveCommand, Kinematics};
 use crate::core::{JobMemory, KernelPool, Pose2, SimClock, SimRng, wrap_angle};
 use crate::localization::NavBelief;
@@ -170,42 +171,6 @@ impl Behaviour {
 
 /// What the heading band adds to each side of the footprint (m).
 const BAND_MARGIN: f64 = 0.1;
-/// What the collision guard adds to the footprint's radius (m): small, so that a robot driving
-/// along a wall inside the heading band is not taken for one touching it.
-const CONTACT_MARGIN: f64 = 0.01;
-/// The collision guard's braking (m/s², well inside what the wheels can do), reaction time (s,
-/// about two ticks and a scan) and the gap it keeps (m).
-const GUARD_DECEL: f64 = 1.0;
-const GUARD_REACTION: f64 = 0.1;
-const GUARD_GAP: f64 = 0.05;
-
-/// The forward speed, at most `v`, from which the robot can still stop short of every seen
-/// point on the arc it drives (yaw rate `w` kept): v·t + v²/2a ≤ free arc − gap, as a collision
-/// monitor's "approach" action does [Nav2 collision monitor]. Lowering v tightens the arc, which
-/// is checked again (a few rounds; every round can only lower v). A disc turning in place
-/// sweeps nothing new, so a stopped robot may always turn.
-pub fn guarded_speed(s: &SectorRanges, v: f64, w: f64, radius: f64) -> f64 {
-    let (a, t) = (GUARD_DECEL, GUARD_REACTION);
-    // nothing within stopping distance of the disc in any direction: nothing to check
-    let reach = radius + GUARD_GAP + v * t + v * v / (2.0 * a);
-    if s.nearest_squared() >= (reach * reach) as f32 {
-        return v;
-    }
-    let mut v = v;
-    for _ in 0..4 {
-        if v <= 1e-6 {
-            return 0.0;
-        }
-        let free = (s.free_arc(w / v, radius, 5.0) - GUARD_GAP).max(0.0);
-        let allowed = (-a * t + ((a * t).powi(2) + 2.0 * a * free).sqrt()).max(0.0);
-        if allowed >= v {
-            return v;
-        }
-        v = allowed;
-    }
-    v
-}
-
 /// Robots from which behaviours run on the kernel pool: about a microsecond each (the laser's
 /// sectors and a heading), so a few do not pay for the hand-over.
 const PARALLEL_ROBOTS: usize = 32;
@@ -249,57 +214,4 @@ pub fn drive_behaviours(
         },
     );
     memory.keep(jobs);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::sensors::LaserScan;
-
-    /// What a 360° laser at the centre sees of a wall across the front at x = `dist`.
-    fn facing_wall(dist: f32) -> SectorRanges {
-        let n = 720;
-        let inc = (2.0 * PI / n as f64) as f32;
-        let ranges = (0..n)
-            .map(|k| {
-                let a = -PI as f32 + k as f32 * inc;
-                if a.cos() > 0.05 {
-                    dist / a.cos()
-                } else {
-                    f32::INFINITY
-                }
-            })
-            .collect();
-        let scan = LaserScan {
-            stamp: 0.0,
-            angle_min: -PI as f32,
-            angle_increment: inc,
-            range_min: 0.05,
-            range_max: 30.0,
-            ranges,
-        };
-        let mut s = SectorRanges::default();
-        s.update(&scan, &Pose2::IDENTITY);
-        s
-    }
-
-    #[test]
-    fn the_guard_stops_short_of_a_wall_and_leaves_free_driving_and_turning_alone() {
-        let (a, t) = (GUARD_DECEL, GUARD_REACTION);
-        let stop = |v: f64| v * t + v * v / (2.0 * a);
-        // far from the wall: the speed asked for
-        assert_eq!(guarded_speed(&facing_wall(5.0), 0.8, 0.0, 0.31), 0.8);
-        // 0.6 m ahead of a 0.31 m disc: the room, less the gap, bounds the stopping distance;
-        // the speed given stops exactly there
-        let v = guarded_speed(&facing_wall(0.6), 0.8, 0.0, 0.31);
-        assert!(v < 0.8, "{v}");
-        assert!((stop(v) - (0.6 - 0.31 - GUARD_GAP)).abs() < 1e-3, "{v}");
-        // touching it: no forward speed, but turning away is the caller's to do
-        assert_eq!(guarded_speed(&facing_wall(0.31), 0.5, 1.0, 0.31), 0.0);
-        // turning hard away from the wall just ahead: the arc leaves it, so more speed than
-        // straight at it
-        let straight = guarded_speed(&facing_wall(0.6), 0.8, 0.0, 0.31);
-        let turning = guarded_speed(&facing_wall(0.6), 0.8, 1.5, 0.31);
-        assert!(turning > straight, "{turning} {straight}");
-    }
 }

@@ -16,6 +16,7 @@
 pub mod astar;
 pub mod avoid;
 pub mod behaviour;
+pub mod collision_guard;
 pub mod costmap;
 pub mod drive;
 pub mod fleet;
