@@ -524,6 +524,9 @@ pub struct PyEstimate {
     covariance: Option<Py<PyAny>>,
     /// When its estimates came and stayed close to the truth (s), None if not (yet).
     converged_after: Option<f64>,
+    /// True while the robot's laser is faulted: the estimate is the last one carried forward
+    /// by the odometry, its covariance growing with the path.
+    degraded: bool,
 }
 
 impl PyEstimate {
@@ -539,6 +542,7 @@ impl PyEstimate {
             pose: l.estimate.map(|e| pose(e.pose)),
             covariance,
             converged_after: l.converged_after,
+            degraded: l.degraded,
         })
     }
 }
@@ -548,8 +552,10 @@ impl PyEstimate {
     fn __repr__(&self) -> String {
         match self.pose {
             Some((x, y, t)) => format!(
-                "<sim.Estimate {} ({}): ({x:.3}, {y:.3}, {t:.3})>",
-                self.name, self.kind
+                "<sim.Estimate {} ({}): ({x:.3}, {y:.3}, {t:.3}){}>",
+                self.name,
+                self.kind,
+                if self.degraded { ", degraded" } else { "" }
             ),
             None => format!("<sim.Estimate {} ({}): none yet>", self.name, self.kind),
         }

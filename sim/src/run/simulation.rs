@@ -499,6 +499,7 @@ impl Simulation {
             wall_time_s,
             real_time_factor: sim_time_s / wall_time_s.max(1e-9),
             robots: collect::robot_summaries(world),
+            timing: collect::timing(world),
         };
         Ok(Finished {
             summary,

@@ -140,6 +140,7 @@ impl<'w> RobotView<'w> {
                         pose: e.estimate.pose,
                         covariance: e.estimate.covariance,
                     }),
+                    degraded: l.degraded,
                     converged_after: samples
                         .and_then(|s| s.per_localizer.iter().find(|(n, _)| *n == l.name))
                         .and_then(|(_, s)| {
@@ -254,6 +255,9 @@ pub struct LocalizerView<'w> {
     pub kind: &'static str,
     /// The latest estimate (None before its first).
     pub estimate: Option<Estimate>,
+    /// The robot's laser is faulted: the estimate is the last one carried forward by the
+    /// odometry, its covariance growing with the path, until the laser works again.
+    pub degraded: bool,
     /// When its estimates came and stayed close to the truth (the summary's convergence,
     /// judged on the estimates so far: known once they have stayed close for the summary's
     /// hold time; s), None if not (yet).

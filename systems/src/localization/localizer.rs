@@ -11,6 +11,7 @@ use super::scan_estimator::ScanEstimator;
 use crate::core::{KernelPool, Pose2};
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
+use rayon::prelude::*;
 
 /// One localization algorithm with its state.
 #[derive(Clone, Debug)]
@@ -71,6 +72,59 @@ impl Filter {
 pub struct StampedEstimate {
     pub stamp: f64,
     pub estimate: PoseEstimate,
+    /// Carried forward by the odometry alone while the laser is faulted (see
+    /// [`Localizer::degraded`]), not the filter's own.
+    pub degraded: bool,
+}
+
+/// Growth of a degraded estimate's standard deviations: position per metre driven, heading
+/// per radian turned and per metre. Odometry's error grows with the path; a few percent per
+/// metre is what real wheels do on real floors [Thrun 2005, §5.4].
+const DEGRADED_SD_PER_M: f64 = 0.05;
+const DEGRADED_SD_RAD_PER_RAD: f64 = 0.05;
+const DEGRADED_SD_RAD_PER_M: f64 = 0.02;
+
+/// Where a degraded estimate is carried from: the filter's last estimate and the odometry pose
+/// of its scan, and the path driven since.
+#[derive(Clone, Copy, Debug)]
+struct Anchor {
+    estimate: PoseEstimate,
+    odom: Pose2,
+    last_odom: Pose2,
+    travelled_m: f64,
+    turned_rad: f64,
+}
+
+impl Anchor {
+    fn new(estimate: PoseEstimate, odom: Pose2) -> Self {
+        Anchor {
+            estimate,
+            odom,
+            last_odom: odom,
+            travelled_m: 0.0,
+            turned_rad: 0.0,
+        }
+    }
+
+    /// The estimate carried to odometry pose `odom`, its covariance grown with the path.
+    fn carry(&mut self, odom: Pose2) -> PoseEstimate {
+        self.travelled_m += self.last_odom.distance(&odom);
+        self.turned_rad += crate::core::wrap_angle(odom.theta - self.last_odom.theta).abs();
+        self.last_odom = odom;
+        let pose = self.estimate.pose.compose(&self.odom.between(&odom));
+        let sd = DEGRADED_SD_PER_M * self.travelled_m;
+        let sd_theta =
+            DEGRADED_SD_RAD_PER_RAD * self.turned_rad + DEGRADED_SD_RAD_PER_M * self.travelled_m;
+        let mut covariance = self.estimate.covariance;
+        covariance[0][0] += sd * sd;
+        covariance[1][1] += sd * sd;
+        covariance[2][2] += sd_theta * sd_theta;
+        PoseEstimate {
+            pose,
+            covariance,
+            weight: self.estimate.weight,
+        }
+    }
 }
 
 /// A named localizer and what it published.
@@ -82,6 +136,42 @@ pub struct Localizer {
     pub latest: Option<StampedEstimate>,
     /// Estimates published during the current tick (cleared at the start of each tick).
     pub fresh: Vec<StampedEstimate>,
+    /// Wall-clock cost of its updates: a measurement of the machine, not of the run, so it is
+    /// kept out of everything determinism covers.
+    pub cost: UpdateCost,
+    /// True while the robot's laser is faulted: a map localizer then cannot correct, so it
+    /// publishes its last estimate carried forward by the odometry, with a covariance that
+    /// grows with the path, until the laser works again and the filter resumes.
+    pub degraded: bool,
+    anchor: Option<Anchor>,
+}
+
+/// What a localizer's updates cost in wall-clock time (one update = one scan consumed).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct UpdateCost {
+    /// Scans consumed.
+    pub updates: u64,
+    /// Their total (s).
+    pub total_s: f64,
+    /// The dearest one (s).
+    pub max_s: f64,
+}
+
+impl UpdateCost {
+    fn add(&mut self, seconds: f64) {
+        self.updates += 1;
+        self.total_s += seconds;
+        self.max_s = self.max_s.max(seconds);
+    }
+
+    /// Mean cost of an update (s); 0 before the first.
+    pub fn mean_s(&self) -> f64 {
+        if self.updates == 0 {
+            0.0
+        } else {
+            self.total_s / self.updates as f64
+        }
+    }
 }
 
 impl Localizer {
@@ -91,6 +181,9 @@ impl Localizer {
             filter,
             latest: None,
             fresh: Vec::new(),
+            cost: UpdateCost::default(),
+            degraded: false,
+            anchor: None,
         }
     }
 
@@ -102,31 +195,64 @@ impl Localizer {
         scan: &ScanInput,
         odom: &Pose2,
     ) {
+        let started = std::time::Instant::now();
+        if self.update(map, scan_stamp, scan, odom) {
+            self.cost.add(started.elapsed().as_secs_f64());
+        }
+    }
+
+    /// False when the filter could not run (a map localizer without a map).
+    fn update(
+        &mut self,
+        map: Option<&LocalizationMap>,
+        scan_stamp: f64,
+        scan: &ScanInput,
+        odom: &Pose2,
+    ) -> bool {
         if let Filter::Scan(f) = &mut self.filter {
             if f.update(scan.scan, &scan.mount, odom)
                 && let Some(e) = f.estimate()
             {
                 self.publish(scan_stamp, e);
             }
-            return;
+            return true;
         }
         let Some(map) = map else {
-            return; // map-based filters only run where the map exists
+            return false; // map-based filters only run where the map exists
         };
         let Filter::Map(f) = &mut self.filter else {
-            return;
+            return false;
         };
         let beams = scan.beams(f.max_beams());
+        self.degraded = false;
         if f.predict(odom)
             && f.correct(map, beams)
             && let Some(e) = f.estimate()
         {
+            self.anchor = Some(Anchor::new(e, *odom));
             self.publish(scan_stamp, e);
+        }
+        true
+    }
+
+    /// Without a laser: a map localizer's last estimate carried to odometry pose `odom` (none
+    /// before its first estimate). SLAM systems wait for scans.
+    fn dead_reckon(&mut self, stamp: f64, odom: Pose2) {
+        if self.filter.is_scan() {
+            return;
+        }
+        self.degraded = true;
+        if let Some(e) = self.anchor.as_mut().map(|a| a.carry(odom)) {
+            self.publish(stamp, e);
         }
     }
 
     fn publish(&mut self, stamp: f64, estimate: PoseEstimate) {
-        let s = StampedEstimate { stamp, estimate };
+        let s = StampedEstimate {
+            stamp,
+            estimate,
+            degraded: self.degraded,
+        };
         self.latest = Some(s);
         self.fresh.push(s);
     }
@@ -164,8 +290,7 @@ pub struct Localizers {
 
 impl Localizers {
     /// Feeds this tick's scans, in time order with the odometry pose at each scan's time, to the
-    /// localizers `select` picks (their fresh estimates cleared first). Kernels inside the
-    /// filters run on the run's rayon pool.
+    /// localizers `select` picks (their fresh estimates cleared first); see [`feed_robots`].
     pub fn feed(
         &mut self,
         map: Option<&LocalizationMap>,
@@ -173,35 +298,98 @@ impl Localizers {
         scans: &LaserScans,
         mount: Pose2,
         odom: &WheelOdometry,
-        select: impl Fn(&Filter) -> bool,
+        select: impl Fn(&Filter) -> bool + Sync,
     ) {
-        let chosen: Vec<usize> = (0..self.items.len())
-            .filter(|&i| select(&self.items[i].filter))
-            .collect();
-        if chosen.is_empty() {
-            return;
+        let robot = RobotFeed {
+            localizers: self,
+            scans,
+            mount,
+            odom,
+            laser_works: true,
+        };
+        feed_robots(map, pool, &mut [robot], select);
+    }
+}
+
+/// One robot's localizers with what feeds them this tick.
+pub struct RobotFeed<'a> {
+    pub localizers: &'a mut Localizers,
+    pub scans: &'a LaserScans,
+    /// The laser's mount on the robot.
+    pub mount: Pose2,
+    pub odom: &'a WheelOdometry,
+    /// False while the laser is faulted: the map localizers are then degraded.
+    pub laser_works: bool,
+}
+
+/// Feeds every robot's scans of this tick, in time order with the odometry pose at each scan's
+/// time, to the localizers `select` picks (their fresh estimates cleared first). Each scan's
+/// beam subsets are built once per robot and distinct beam count. The localizers run side by
+/// side on the run's pool, each through its own scans in order (each owns its state and random
+/// stream, so the results do not depend on the threads); kernels inside a filter share the pool.
+/// A robot whose laser is faulted has its map localizers degraded (see [`Localizer::degraded`]).
+pub fn feed_robots(
+    map: Option<&LocalizationMap>,
+    pool: &KernelPool,
+    robots: &mut [RobotFeed],
+    select: impl Fn(&Filter) -> bool + Sync,
+) {
+    let inputs: Vec<Vec<(ScanInput, Pose2)>> = robots
+        .iter()
+        .map(|r| {
+            let beams: Vec<usize> = r
+                .localizers
+                .items
+                .iter()
+                .filter(|l| select(&l.filter) && !l.filter.is_scan())
+                .map(|l| l.filter.max_beams())
+                .collect();
+            r.scans
+                .scans
+                .iter()
+                .map(|scan| {
+                    let mut input = ScanInput {
+                        scan,
+                        mount: r.mount,
+                        subsets: Vec::new(),
+                    };
+                    for &b in &beams {
+                        input.prepare(b);
+                    }
+                    (input, r.odom.pose_at(scan.stamp))
+                })
+                .collect()
+        })
+        .collect();
+    for r in robots.iter_mut().filter(|r| !r.laser_works) {
+        let (stamp, pose) = (r.odom.stamp, r.odom.pose);
+        for l in r.localizers.items.iter_mut().filter(|l| select(&l.filter)) {
+            l.fresh.clear();
+            l.dead_reckon(stamp, pose);
         }
-        for &i in &chosen {
-            self.items[i].fresh.clear();
+    }
+    let mut jobs: Vec<(&mut Localizer, &[(ScanInput, Pose2)])> = robots
+        .iter_mut()
+        .zip(&inputs)
+        .filter(|(r, _)| r.laser_works)
+        .flat_map(|(r, input)| {
+            r.localizers
+                .items
+                .iter_mut()
+                .filter(|l| select(&l.filter))
+                .map(move |l| (l, &input[..]))
+        })
+        .collect();
+    let run = |(loc, input): &mut (&mut Localizer, &[(ScanInput, Pose2)])| {
+        loc.fresh.clear();
+        for (scan, at) in input.iter() {
+            loc.consume(map, scan.scan.stamp, scan, at);
         }
-        for scan in &scans.scans {
-            let mut input = ScanInput {
-                scan,
-                mount,
-                subsets: Vec::new(),
-            };
-            for &i in &chosen {
-                if !self.items[i].filter.is_scan() {
-                    input.prepare(self.items[i].filter.max_beams());
-                }
-            }
-            let at = odom.pose_at(scan.stamp);
-            pool.install(|| {
-                for &i in &chosen {
-                    self.items[i].consume(map, scan.stamp, &input, &at);
-                }
-            });
-        }
+    };
+    match jobs.len() {
+        0 => {}
+        1 => pool.install(|| run(&mut jobs[0])),
+        _ => pool.install(|| jobs.par_iter_mut().for_each(run)),
     }
 }
 
@@ -215,9 +403,15 @@ pub fn run_localizers(
     let Some(map) = map else {
         return; // no robot carries a localizer
     };
-    for (mut locs, scans, laser, odom) in robots.iter_mut() {
-        locs.feed(Some(&map), &pool, scans, laser.spec.mount, odom, |f| {
-            !f.is_scan()
-        });
-    }
+    let mut feeds: Vec<RobotFeed> = robots
+        .iter_mut()
+        .map(|(locs, scans, laser, odom)| RobotFeed {
+            localizers: locs.into_inner(),
+            scans,
+            mount: laser.spec.mount,
+            odom,
+            laser_works: laser.enabled,
+        })
+        .collect();
+    feed_robots(Some(&map), &pool, &mut feeds, |f| !f.is_scan());
 }

@@ -24,7 +24,7 @@ pub mod scan_estimator;
 #[cfg(test)]
 pub(crate) mod test_drive;
 
-pub use localizer::{Filter, Localizer, Localizers, StampedEstimate};
+pub use localizer::{Filter, Localizer, Localizers, StampedEstimate, UpdateCost};
 pub use map::LocalizationMap;
 pub use map_localizer::MapLocalizer;
 pub use markov_grid::{MarkovGrid, MarkovGridConfig};

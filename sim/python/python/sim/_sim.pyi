@@ -284,6 +284,8 @@ class Estimate:
     pose: Pose | None
     covariance: npt.NDArray[np.float64] | None
     converged_after: float | None
+    degraded: bool
+    """True while the robot's laser is faulted: the last estimate carried by the odometry."""
 
 class Observation:
     """What a controller sees at a tick; valid during its call only."""

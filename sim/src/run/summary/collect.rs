@@ -1,7 +1,7 @@
 //! What a finished world says: one summary row per robot, every localizer's samples paired with
 //! the truth, and the event log.
 
-use super::{NavigationFailure, NavigationSummary, RobotSummary};
+use super::{LocalizerTiming, NavigationFailure, NavigationSummary, RobotSummary, Timing};
 use crate::formats::tum::RobotLocalization;
 use bevy_ecs::prelude::*;
 use systems::body::TruePose;
@@ -89,6 +89,28 @@ pub(crate) fn robot_summaries(w: &mut World) -> Vec<RobotSummary> {
         .collect();
     rows.sort_by_key(|(i, _)| *i);
     rows.into_iter().map(|(_, r)| r).collect()
+}
+
+/// Each localizer's wall-clock cost per update, robots in index order.
+pub(crate) fn timing(w: &mut World) -> Timing {
+    let mut q = w.query::<(&RobotIndex, &RobotId, &Localizers)>();
+    let mut robots: Vec<_> = q.iter(w).collect();
+    robots.sort_by_key(|(i, _, _)| **i);
+    let localizers = robots
+        .into_iter()
+        .flat_map(|(_, id, locs)| {
+            locs.items.iter().map(|l| LocalizerTiming {
+                robot: id.0.clone(),
+                localizer: l.name.clone(),
+                kind: l.filter.kind().to_string(),
+                updates: l.cost.updates,
+                total_s: l.cost.total_s,
+                mean_update_us: l.cost.mean_s() * 1e6,
+                max_update_us: l.cost.max_s * 1e6,
+            })
+        })
+        .collect();
+    Timing { localizers }
 }
 
 fn navigation_summary(n: &Navigator, o: &NavOutcome, m: &RobotMetrics) -> NavigationSummary {

@@ -22,6 +22,35 @@ pub struct Summary {
     pub real_time_factor: f64,
     /// Each robot, in scenario order.
     pub robots: Vec<RobotSummary>,
+    /// What the run cost in wall-clock time, part by part.
+    pub timing: Timing,
+}
+
+/// Wall-clock measurements of a run. Like `wall_time_s` they describe the machine, not the run:
+/// `deterministic_part` clears them.
+#[derive(Serialize, Clone, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// Each localizer's cost per update, robot by robot in scenario order.
+    pub localizers: Vec<LocalizerTiming>,
+}
+
+/// One localizer's cost per update (one update = one scan consumed).
+#[derive(Serialize, Clone, Debug, PartialEq)]
+pub struct LocalizerTiming {
+    /// The robot's name.
+    pub robot: String,
+    /// The localizer's name.
+    pub localizer: String,
+    /// Its type.
+    pub kind: String,
+    /// Scans consumed.
+    pub updates: u64,
+    /// Their total wall-clock time (s).
+    pub total_s: f64,
+    /// Mean per update (µs).
+    pub mean_update_us: f64,
+    /// The dearest update (µs).
+    pub max_update_us: f64,
 }
 
 /// One robot's results.
@@ -124,6 +153,7 @@ impl Summary {
         Summary {
             wall_time_s: 0.0,
             real_time_factor: 0.0,
+            timing: Timing::default(),
             ..self.clone()
         }
     }
@@ -211,7 +241,7 @@ impl Summary {
             .collect();
         if !with_loc.is_empty() {
             s += &format!(
-                "\n{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9}\n",
+                "\n{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9} {:>10}\n",
                 "robot",
                 "localizer",
                 "estimates",
@@ -219,7 +249,8 @@ impl Summary {
                 "RPE m",
                 "RPE rad",
                 "converged s",
-                "tracked %"
+                "tracked %",
+                "µs/update"
             );
             let opt = |v: Option<f64>, prec: usize| match v {
                 Some(v) => format!("{v:.prec$}"),
@@ -227,8 +258,15 @@ impl Summary {
             };
             for r in with_loc {
                 for (name, m) in &r.localization {
+                    let cost = self
+                        .timing
+                        .localizers
+                        .iter()
+                        .find(|t| t.robot == r.name && t.localizer == *name)
+                        .filter(|t| t.updates > 0)
+                        .map(|t| t.mean_update_us);
                     s += &format!(
-                        "{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9}\n",
+                        "{:<16} {:<14} {:>9} {:>10} {:>10} {:>12} {:>11} {:>9} {:>10}\n",
                         r.name,
                         name,
                         m.estimates,
@@ -237,11 +275,12 @@ impl Summary {
                         opt(m.rpe_rot_rad, 4),
                         opt(m.converged_after_s, 1),
                         opt(m.tracked_fraction.map(|f| 100.0 * f), 1),
+                        opt(cost, 0),
                     );
                 }
             }
             s += "ATE: in the map frame for localizers in the map, aligned at the first pose for \
-                  odometry and SLAM\n";
+                  odometry and SLAM; µs/update: wall-clock cost of one scan\n";
         }
         s
     }

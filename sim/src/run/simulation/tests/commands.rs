@@ -339,3 +339,81 @@ fn bad_goals_are_typed_errors() {
         Err(SimError::NotNavigating { robot }) if robot == "r1"
     ));
 }
+
+#[test]
+fn a_faulted_laser_leaves_the_localizers_degraded_on_the_odometry_never_nan() {
+    let mut s = from_text(&patrol_text(), "patrol")
+        .duration(12.0)
+        .threads(1)
+        .build()
+        .unwrap();
+    let fault = |active| Command::SensorFault {
+        sensor: SensorName::Laser,
+        active,
+    };
+    let mcl = |s: &Simulation| {
+        let r1 = s.robot("r1").unwrap();
+        let l = r1.localizers()[0];
+        assert_eq!(l.name, "mcl");
+        let e = l
+            .estimate
+            .expect("mcl from its start pose publishes at once");
+        let truth = r1.pose();
+        (
+            e,
+            l.degraded,
+            (e.pose.x - truth.x).hypot(e.pose.y - truth.y),
+        )
+    };
+    s.run_for(2.0).unwrap();
+    let (healthy, degraded, _) = mcl(&s);
+    assert!(!degraded);
+    s.command("r1", fault(true)).unwrap();
+    s.command("r1", Command::Drive { v: 0.3, w: 0.2 }).unwrap();
+    s.run_for(3.0).unwrap();
+    // every map localizer of r1 says so, and publishes each tick, finite
+    let r1 = s.robot("r1").unwrap();
+    for l in r1.localizers() {
+        assert!(l.degraded, "{}", l.name);
+        if let Some(e) = l.estimate {
+            assert!(
+                (e.stamp - s.time()).abs() < 0.06,
+                "{} at {}",
+                l.name,
+                e.stamp
+            );
+            let values = [e.pose.x, e.pose.y, e.pose.theta];
+            assert!(values.iter().all(|v| v.is_finite()), "{}", l.name);
+            assert!(
+                e.covariance.concat().iter().all(|v| v.is_finite()),
+                "{}",
+                l.name
+            );
+        }
+    }
+    // the others' lasers still work
+    assert!(
+        s.robot("r2")
+            .unwrap()
+            .localizers()
+            .iter()
+            .all(|l| !l.degraded)
+    );
+    // mcl followed the robot on the odometry, and its covariance grew with the path
+    let (carried, _, error) = mcl(&s);
+    assert!(error < 0.15, "carried {error} m off");
+    let spread = |e: &crate::run::view::Estimate| e.covariance[0][0] + e.covariance[1][1];
+    assert!(
+        spread(&carried) > spread(&healthy) + 2.0 * (0.05f64 * 0.8).powi(2),
+        "{:?} → {:?}",
+        healthy.covariance,
+        carried.covariance
+    );
+    // the laser back: the filter corrects again
+    s.command("r1", fault(false)).unwrap();
+    s.command("r1", Command::Release).unwrap();
+    s.run_for(3.0).unwrap();
+    let (back, degraded, error) = mcl(&s);
+    assert!(!degraded && (back.stamp - s.time()).abs() < 1.0, "{back:?}");
+    assert!(error < 0.15, "{error} m off after the fault");
+}
