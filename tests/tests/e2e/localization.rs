@@ -115,7 +115,7 @@ fn hospital_patrol_runs_every_localizer_type_on_every_robot() {
 /// localizer within 30 s; during a laser fault window (8–11 s, in a straight corridor) the localizers
 /// wait, then go on.
 #[test]
-fn kidnapped_robot_is_recovered_within_30_s() {
+fn kidnapped_robot_is_recovered_within_30_s_and_a_faulted_laser_degrades_it() {
     let text = r#"
 name = "kidnap"
 seed = 3
@@ -192,10 +192,13 @@ active = false
             recovered.is_some_and(|t| t <= 30.0),
             "{name}: recovered after {recovered:?} s"
         );
-        // no update without scans in the fault window (the last one may land in its first tick)
+        // without scans in the fault window the localizer is degraded: its estimate, carried by
+        // the odometry, still comes every tick, finite and on the robot
+        let degraded: Vec<_> = samples.iter().filter(|s| s.t > 8.1 && s.t < 11.0).collect();
+        assert!(degraded.len() >= 55, "{name}: {} estimates", degraded.len());
         assert!(
-            !samples.iter().any(|s| s.t > 8.1 && s.t < 11.0),
-            "{name} updated while the laser was off"
+            degraded.iter().all(|s| s.position_error() < 0.2),
+            "{name} degraded but lost"
         );
         assert!(
             samples.iter().any(|s| s.t > 11.0 && s.t < 12.0),
