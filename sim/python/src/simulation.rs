@@ -552,13 +552,21 @@ impl PySimulation {
     }
 
     /// Writes the finished run's trajectories as TUM files (`DIR/<robot>/<localizer>.tum`
-    /// and `.truth.tum`, from convergence on, as `sim run --tum` does); the files written.
-    fn write_tum(&self, dir: PathBuf) -> PyResult<Vec<PathBuf>> {
+    /// and `.truth.tum`, as `sim run --trajectories` does): from convergence on, or with
+    /// `all_estimates` every estimate from the first; the files written.
+    #[pyo3(signature = (dir, *, all_estimates = false))]
+    fn write_tum(&self, dir: PathBuf, all_estimates: bool) -> PyResult<Vec<PathBuf>> {
+        use sim::formats::tum::{Estimates, write_trajectories};
         let guard = self.lock()?;
         let State::Finished { localization, .. } = &*guard else {
             return Err(SimError::new_err("trajectories are written once finished"));
         };
-        sim::formats::tum::write_trajectories(&dir, localization).map_err(engine_error)
+        let which = if all_estimates {
+            Estimates::All
+        } else {
+            Estimates::FromConvergence
+        };
+        write_trajectories(&dir, localization, which).map_err(engine_error)
     }
 
     /// Starts the scenario again from its first tick with `seed`, as a simulation built

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import sim
-from conftest import verify_rrd
+from conftest import ASSETS, verify_rrd
 
 
 def test_bundled_scenarios_are_listed():
@@ -156,6 +156,45 @@ def test_slam_map_and_trajectory_as_arrays(maze_slam_toml):
     s.finish()
     traj = s.trajectories()["scout"]
     assert traj["mcl"].shape[1] == 7
+
+
+def test_tum_files_hold_every_estimate_when_asked(tmp_path):
+    # a global MCL that converges after its first estimates: the default files start there
+    hospital = ASSETS / "maps" / "hospital"
+    toml = f"""
+name = "hospital_global"
+duration = 20.0
+[map]
+file = "{hospital / 'hospital.yaml'}"
+places = "{hospital / 'places.toml'}"
+[[robots]]
+name = "r1"
+start = "charger_1"
+footprint = {{ circle = 0.3 }}
+behaviour = {{ type = "waypoints", loop = true, speed = 0.8, points = [[3.8, 16.0], "pharmacy"] }}
+[robots.sensors.laser]
+preset = "sick_lms100"
+rate = 10.0
+[robots.sensors.encoder]
+[[robots.localization]]
+type = "mcl"
+init = "global"
+max_particles = 100000
+"""
+    s = sim.Simulation.from_toml(toml, label="hospital_global.toml")
+    s.run()
+    rows = s.trajectories()["r1"]["mcl"]
+    every = s.write_tum(tmp_path / "all", all_estimates=True)
+    judged = s.write_tum(tmp_path / "judged")
+    assert len(every) == len(judged) > 0
+
+    def times(path):
+        return [float(line.split()[0]) for line in open(path)]
+
+    all_t = times(tmp_path / "all" / "r1" / "mcl.tum")
+    judged_t = times(tmp_path / "judged" / "r1" / "mcl.tum")
+    assert len(all_t) == len(rows) and abs(all_t[0] - rows[0, 0]) < 1e-6
+    assert 0 < len(judged_t) < len(all_t) and judged_t[-1] == all_t[-1]
 
 
 def test_camera_frames_are_rgb_arrays():

@@ -22,12 +22,23 @@ pub fn tum_line(t: f64, p: &Pose2) -> String {
     format!("{t:.6} {:.9} {:.9} 0 0 0 {s:.12} {c:.12}", p.x, p.y)
 }
 
+/// Which of a localizer's estimates a trajectory file holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Estimates {
+    /// From convergence on: the samples the summary's ATE and RPE judge.
+    #[default]
+    FromConvergence,
+    /// Every estimate from the first, so a global localizer can be scored over the whole run.
+    All,
+}
+
 /// Writes `DIR/<robot>/<localizer>.tum` (estimates) and `DIR/<robot>/<localizer>.truth.tum`
-/// (ground truth at the same timestamps), over the samples the metrics judge (from convergence
-/// on). Returns the files written.
+/// (ground truth at the same timestamps), over the samples `which` names. Returns the files
+/// written.
 pub fn write_trajectories(
     dir: &Path,
     robots: &[RobotLocalization],
+    which: Estimates,
 ) -> anyhow::Result<Vec<std::path::PathBuf>> {
     let mut written = Vec::new();
     for r in robots {
@@ -35,9 +46,12 @@ pub fn write_trajectories(
         std::fs::create_dir_all(&rdir)
             .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", rdir.display()))?;
         for (name, samples) in &r.localizers {
-            let judged = judged_samples(samples);
+            let kept = match which {
+                Estimates::FromConvergence => judged_samples(samples),
+                Estimates::All => samples,
+            };
             let (mut est, mut truth) = (String::new(), String::new());
-            for s in judged {
+            for s in kept {
                 let _ = writeln!(est, "{}", tum_line(s.t, &s.estimate));
                 let _ = writeln!(truth, "{}", tum_line(s.t, &s.truth));
             }

@@ -39,6 +39,10 @@ pub struct ReplayArgs {
     /// /<robot>/ground_truth in our files, none otherwise).
     #[arg(long)]
     pub truth_topic: Option<String>,
+    /// Replay a file cut short or damaged: the messages of every complete chunk before the
+    /// damage, which is named on standard error (default: such a file is an error).
+    #[arg(long)]
+    pub recover: bool,
     #[command(flatten)]
     pub out: OutputArgs,
 }

@@ -93,9 +93,26 @@ pub fn build_replay(plan: ReplayPlan, threads: usize) -> anyhow::Result<(SimWorl
     Ok((sim, scenario))
 }
 
+/// The file `sim replay` reads: whole, or with `--recover` what precedes its damage (then
+/// named in [`McapRecording::damage`]).
+pub fn open_recording(a: &ReplayArgs) -> anyhow::Result<McapRecording> {
+    if a.recover {
+        McapRecording::open_recovering(&a.file)
+    } else {
+        McapRecording::open(&a.file)
+    }
+}
+
 /// `sim replay`.
 pub fn replay_command(a: &ReplayArgs) -> anyhow::Result<()> {
-    let rec = McapRecording::open(&a.file)?;
+    let rec = open_recording(a)?;
+    if let Some(damage) = &rec.damage {
+        eprintln!(
+            "{}: {damage}; replaying the {} messages before it",
+            a.file.display(),
+            rec.messages.len()
+        );
+    }
     let plan = plan(a, &rec)?;
     drop(rec);
     let sc = &plan.scenario;
@@ -119,6 +136,9 @@ pub fn replay_command(a: &ReplayArgs) -> anyhow::Result<()> {
                 "note: no ground truth topic (--truth-topic): error figures are against the start \
                  pose and mean nothing"
             );
+        }
+        for note in plan.feeds.iter().flat_map(|f| &f.notes) {
+            eprintln!("note: {note}");
         }
     }
     let rrd = a.out.rrd_path(|| {

@@ -9,7 +9,7 @@ use crate::record::mcap::McapRecording;
 use crate::record::topics::RunInfo;
 use crate::scenario::scenario_path;
 use crate::scenario::source::Source;
-use crate::scenario::{Scenario, assets_dir};
+use crate::scenario::{OdometrySource, Scenario, assets_dir};
 use anyhow::{anyhow, bail};
 use std::path::{Path, PathBuf};
 
@@ -48,7 +48,11 @@ fn base_dirs(run: &RunInfo, file: &Path) -> Vec<PathBuf> {
 }
 
 /// The scenario attached to our own file, loaded against the first folder its paths resolve in.
-fn attached_source(rec: &McapRecording, run: &RunInfo) -> anyhow::Result<Source> {
+fn attached_source(
+    rec: &McapRecording,
+    run: &RunInfo,
+    odometry: OdometrySource,
+) -> anyhow::Result<Source> {
     let Some(a) = rec.attachment("scenario.toml") else {
         bail!(
             "{}: no scenario.toml attachment; give the scenario with --scenario",
@@ -64,7 +68,7 @@ fn attached_source(rec: &McapRecording, run: &RunInfo) -> anyhow::Result<Source>
     let label = format!("{} (attached scenario.toml)", rec.path.display());
     let mut first_error = None;
     for dir in base_dirs(run, &rec.path) {
-        match Source::from_text(text, &label, &dir, &run.scenario) {
+        match Source::from_text_with(text, &label, &dir, &run.scenario, odometry) {
             Ok(s) => return Ok(s),
             Err(e) => {
                 first_error.get_or_insert(e);
@@ -77,9 +81,15 @@ fn attached_source(rec: &McapRecording, run: &RunInfo) -> anyhow::Result<Source>
 /// Reads the plan of `sim replay` from the arguments and the opened recording.
 pub fn plan(a: &ReplayArgs, rec: &McapRecording) -> anyhow::Result<ReplayPlan> {
     let run = run_info(rec)?;
+    // foreign files replay an odometry topic (default /odom), our own the encoder ticks
+    let odometry = if run.is_none() || a.odom_topic.is_some() {
+        OdometrySource::Recorded
+    } else {
+        OdometrySource::Encoders
+    };
     let source = match (&a.scenario, &run) {
-        (Some(s), _) => Source::load(&scenario_path(Some(s))?)?,
-        (None, Some(run)) => attached_source(rec, run)?,
+        (Some(s), _) => Source::load_with(&scenario_path(Some(s))?, odometry)?,
+        (None, Some(run)) => attached_source(rec, run, odometry)?,
         (None, None) => bail!(
             "{}: not written by `sim run --mcap` (no run.json attachment): give the map and robot \
              with --scenario, and the topics with --scan-topic and --odom-topic if they are not \

@@ -13,7 +13,7 @@ use crate::scenario::RobotConfig;
 use anyhow::{anyhow, bail};
 use systems::body::Kinematics;
 use systems::core::Pose2;
-use systems::sensors::{EncoderReading, LaserScan};
+use systems::sensors::{EncoderReading, LaserScan, LaserSpec};
 
 /// Topic names given on the command line (`None`: the default of the file's kind).
 #[derive(Clone, Debug, Default)]
@@ -37,6 +37,8 @@ pub struct RobotFeed {
     pub truth: Vec<(f64, Pose2)>,
     /// Which topics were read, for the report.
     pub topics: Vec<String>,
+    /// What the user should know about these readings (printed before the replay).
+    pub notes: Vec<String>,
 }
 
 /// How stamps become simulation times.
@@ -130,6 +132,67 @@ fn scan_of(m: ScanMsg, stamp: f64) -> LaserScan {
         range_max: hi,
         ranges,
     }
+}
+
+/// A scan's geometry: beams, first angle, increment, range limits.
+fn geometry(s: &LaserScan) -> (usize, f32, f32, f32, f32) {
+    let (a, i) = (s.angle_min, s.angle_increment);
+    (s.ranges.len(), a, i, s.range_min, s.range_max)
+}
+
+/// Says so when the scans of `topic` do not have the beams of the scenario's laser (count,
+/// angles or range limits), or change geometry within the file: the localizers and maps use
+/// each message's own angles and limits, and the scenario's laser gives only its mount.
+pub fn laser_mismatch(
+    robot: &str,
+    topic: &str,
+    laser: &LaserSpec,
+    scans: &[LaserScan],
+) -> Option<String> {
+    let first = scans.first()?;
+    let got = geometry(first);
+    let want = (
+        laser.beams(),
+        laser.angle_min() as f32,
+        laser.increment as f32,
+        laser.min_range as f32,
+        laser.max_range as f32,
+    );
+    let describe = |(n, a, i, lo, hi): (usize, f32, f32, f32, f32)| {
+        format!(
+            "{n} beams from {:.2}° every {:.3}°, {lo}–{hi} m",
+            a.to_degrees(),
+            i.to_degrees()
+        )
+    };
+    let near = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()).max(1.0);
+    let same = got.0 == want.0
+        && near(got.1, want.1)
+        && near(got.2, want.2)
+        && near(got.3, want.3)
+        && near(got.4, want.4);
+    let changes = scans.iter().filter(|s| geometry(s) != got).count();
+    let mut note = String::new();
+    if !same {
+        note = format!(
+            "robot `{robot}`: the scans on {topic} have {}; the scenario's laser has {}. The \
+             messages' angles and limits are used; the scenario's laser gives only the mount",
+            describe(got),
+            describe(want)
+        );
+    }
+    if changes > 0 {
+        if !note.is_empty() {
+            note.push_str(". ");
+        }
+        note.push_str(&format!(
+            "robot `{robot}`: {changes} of the {} scans on {topic} have another geometry than \
+             the first ({}); each is used with its own",
+            scans.len(),
+            describe(got)
+        ));
+    }
+    (!note.is_empty()).then_some(note)
 }
 
 fn planar(p: &Pose) -> Pose2 {
@@ -284,6 +347,10 @@ pub fn robot_feed(
             })
             .collect();
         feed.scans.sort_by(|a, b| a.stamp.total_cmp(&b.stamp));
+        if let Some(laser) = &robot.laser {
+            feed.notes
+                .extend(laser_mismatch(r, &topic, laser, &feed.scans));
+        }
         feed.topics.push(topic);
     } else if let Some(t) = &flags.scan {
         bail!(

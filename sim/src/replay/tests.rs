@@ -39,7 +39,7 @@ fn args(file: &Path, extra: &[&str]) -> ReplayArgs {
 }
 
 fn replay_file(a: &ReplayArgs) -> anyhow::Result<RunOutput> {
-    let rec = McapRecording::open(&a.file)?;
+    let rec = open_recording(a)?;
     replay(
         plan(a, &rec)?,
         &RunOptions::default(),
@@ -230,6 +230,100 @@ fn a_foreign_file_of_scans_and_odometry_localizes_the_chosen_robot() {
     assert!(ate < 0.3, "mcl ATE {ate} m");
 }
 
+/// `hospital_patrol` without any `[robots.sensors.encoder]`, its paths made absolute, written
+/// to `dir`: a scenario for replaying an odometry topic.
+fn patrol_without_encoders(dir: &Path) -> PathBuf {
+    let maps = assets_dir().join("maps");
+    let text = std::fs::read_to_string(scenario_file("hospital_patrol"))
+        .unwrap()
+        .replace("\"../maps/", &format!("\"{}/", maps.display()));
+    let mut kept = Vec::new();
+    let mut skip = false;
+    for line in text.lines() {
+        if line.starts_with('[') {
+            skip = line.trim() == "[robots.sensors.encoder]";
+        }
+        if !skip {
+            kept.push(line);
+        }
+    }
+    let path = dir.join("no_encoders.toml");
+    std::fs::write(&path, kept.join("\n")).unwrap();
+    path
+}
+
+/// Foxglove's Python writer (mcap-ros2-support, zstd chunks by default as rosbag2 writes them)
+/// re-writes one robot's `/scan`, `/odom` and `/truth` (tests/foreign_mcap.py). The file
+/// replays in a scenario without encoders, each compression giving the same estimates; scans
+/// with other angles than the scenario's laser are replayed with a note saying so.
+#[test]
+fn a_zstd_file_of_another_writer_replays_without_encoders() {
+    use systems::core::test_tools::{TestTool, test_tool};
+    let Some(venv) = test_tool(TestTool::McapReaders) else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let own = dir.path().join("own.mcap");
+    live("hospital_patrol", 10.0, &own);
+    let rewrite = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let script = systems::core::source::source_path("tests/foreign_mcap.py");
+        let run = std::process::Command::new(venv.join("bin/python"))
+            .arg(script)
+            .arg(&own)
+            .arg(&out)
+            .args(["--robot", "r2"])
+            .args(extra)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&run.stdout).to_string()
+            + &String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{text}");
+        out
+    };
+    let scenario = patrol_without_encoders(dir.path());
+    let sc = scenario.to_str().unwrap();
+    let flags = ["--scenario", sc, "--robot", "r2", "--truth-topic", "/truth"];
+    // the scenario alone is not runnable: its robots' localizers have no odometry
+    let e = crate::scenario::load_scenario(&scenario)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("[robots.sensors.encoder]"), "{e}");
+
+    let zstd = rewrite("zstd.mcap", &[]);
+    let out = replay_file(&args(&zstd, &flags)).unwrap();
+    let r = &out.summary.robots[0];
+    assert_eq!(r.name, "r2");
+    let ate = r.localization["mcl"].ate_rmse_m.unwrap();
+    assert!(ate < 0.3, "mcl ATE {ate} m");
+    let plan_of = |f: &Path| {
+        let a = args(f, &flags);
+        plan(&a, &open_recording(&a).unwrap()).unwrap()
+    };
+    assert!(plan_of(&zstd).feeds[0].notes.is_empty());
+    for compression in ["lz4", "none"] {
+        let other = rewrite(
+            &format!("{compression}.mcap"),
+            &["--compression", compression],
+        );
+        let again = replay_file(&args(&other, &flags)).unwrap();
+        assert_eq!(
+            again.summary.deterministic_part(),
+            out.summary.deterministic_part(),
+            "{compression}"
+        );
+    }
+
+    let finer = rewrite("finer.mcap", &["--increment-scale", "0.5"]);
+    let notes = &plan_of(&finer).feeds[0].notes;
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert!(
+        notes[0].contains("every 0.125°") && notes[0].contains("every 0.250°"),
+        "{}",
+        notes[0]
+    );
+}
+
 #[test]
 fn missing_topics_attachments_and_damage_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -279,7 +373,17 @@ fn missing_topics_attachments_and_damage_are_clear_errors() {
     let cut = dir.path().join("cut.mcap");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
     let e = msg(&args(&cut, &[]));
-    assert!(e.contains("cut.mcap"), "{e}");
+    assert!(e.contains("cut.mcap") && e.contains("--recover"), "{e}");
+    // --recover replays the complete chunks before the cut: the first part of the run
+    let whole = replay_file(&args(&own, &[])).unwrap();
+    let part = replay_file(&args(&cut, &["--recover"])).unwrap();
+    let estimates = |o: &RunOutput| o.summary.robots[0].localization["mcl"].estimates;
+    assert!(
+        part.summary.sim_time_s < whole.summary.sim_time_s && estimates(&part) > 0,
+        "{} s, {} estimates",
+        part.summary.sim_time_s,
+        estimates(&part)
+    );
     let bad = dir.path().join("bad.mcap");
     let mut flipped = bytes.clone();
     let mid = flipped.len() / 3;

@@ -2,7 +2,7 @@
 //! summary, trajectories, maps, threads) and the report of a finished run.
 
 use super::RunOutput;
-use crate::formats::tum::write_trajectories;
+use crate::formats::tum::{Estimates, write_trajectories};
 use crate::run::RunOptions;
 use std::path::{Path, PathBuf};
 
@@ -24,6 +24,10 @@ pub struct OutputArgs {
     /// Write ground truth and every localizer's estimates here in TUM format (for evo).
     #[arg(long)]
     pub trajectories: Option<PathBuf>,
+    /// With --trajectories: every estimate from the first, before convergence too (default:
+    /// from convergence on, the estimates the summary's ATE and RPE judge).
+    #[arg(long, requires = "trajectories")]
+    pub all_estimates: bool,
     /// Save the maps as map_server YAML + PGM: every SLAM system's, and a known-pose map per
     /// robot with a laser and no SLAM; several: `-<robot>-<name>` after the stem.
     #[arg(long)]
@@ -59,6 +63,11 @@ impl OutputArgs {
             quiet: self.quiet,
             rrd,
             trajectories: self.trajectories.as_deref(),
+            estimates: if self.all_estimates {
+                Estimates::All
+            } else {
+                Estimates::FromConvergence
+            },
             summary: self.summary.as_deref(),
             log,
         }
@@ -78,6 +87,8 @@ pub struct RunReport<'a> {
     pub rrd: Option<&'a Path>,
     /// Where to write the trajectories (TUM files, a folder).
     pub trajectories: Option<&'a Path>,
+    /// Which estimates the trajectories hold.
+    pub estimates: Estimates,
     /// Where to write the summary (JSON).
     pub summary: Option<&'a Path>,
     /// Where to write the event log.
@@ -112,7 +123,7 @@ pub fn report_run(out: &RunOutput, r: &RunReport<'_>) -> anyhow::Result<()> {
         }
     }
     if let Some(dir) = r.trajectories {
-        let files = write_trajectories(dir, &out.localization)?;
+        let files = write_trajectories(dir, &out.localization, r.estimates)?;
         if !r.quiet {
             println!(
                 "{} trajectory files written to {}",

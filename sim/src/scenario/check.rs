@@ -17,6 +17,19 @@ pub(super) type R<T> = Result<T, ScenarioError>;
 
 pub(super) struct Checker<'a> {
     pub(super) cx: ErrorContext<'a>,
+    /// Where the robots' odometry comes from (what a localizer needs besides the laser).
+    pub(super) odometry: OdometrySource,
+}
+
+/// Where the robots' odometry comes from: what decides whether a robot with localizers or SLAM
+/// needs `[robots.sensors.encoder]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OdometrySource {
+    /// The simulated wheel encoders (a run; a replay of recorded encoder ticks).
+    #[default]
+    Encoders,
+    /// Recorded odometry poses (a replay of an odometry topic): no encoder needed.
+    Recorded,
 }
 
 impl Checker<'_> {

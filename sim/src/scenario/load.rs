@@ -1,5 +1,6 @@
 //! Finding and loading scenario files: a path or the name of a bundled scenario.
 
+use super::check::OdometrySource;
 use super::error::ScenarioError;
 use super::model::Scenario;
 use std::path::{Path, PathBuf};
@@ -28,7 +29,25 @@ pub fn parse_scenario(
     base_dir: &Path,
     default_name: &str,
 ) -> Result<Scenario, ScenarioError> {
-    super::resolve::resolve(text, file_label, base_dir, default_name)
+    parse_scenario_with(
+        text,
+        file_label,
+        base_dir,
+        default_name,
+        OdometrySource::Encoders,
+    )
+}
+
+/// [`parse_scenario`] for robots whose odometry comes from `odometry` (a replay of recorded
+/// odometry needs no encoders in the scenario).
+pub fn parse_scenario_with(
+    text: &str,
+    file_label: &str,
+    base_dir: &Path,
+    default_name: &str,
+    odometry: OdometrySource,
+) -> Result<Scenario, ScenarioError> {
+    super::resolve::resolve(text, file_label, base_dir, default_name, odometry)
 }
 
 /// A copy of the assets that a package carries with it ([`use_bundled_assets`]).

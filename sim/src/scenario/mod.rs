@@ -29,7 +29,20 @@ pub mod sonar;
 pub mod source;
 
 pub use builder::{CODE_LABEL, RobotBuilder, ScenarioBuilder};
-pub use check::PointOrPlace;
+pub use check::{OdometrySource, PointOrPlace};
+
+/// A 10 × 10 m room walled on four sides, 1 s long: the start of the scenario texts of unit
+/// tests, which add their robots.
+#[cfg(test)]
+pub(crate) const TEST_ROOM: &str = r#"
+duration = 1.0
+walls = [
+  { from = [0.0, 0.0], to = [10.0, 0.0] },
+  { from = [0.0, 10.0], to = [10.0, 10.0] },
+  { from = [0.0, 0.0], to = [0.0, 10.0] },
+  { from = [10.0, 0.0], to = [10.0, 10.0] },
+]
+"#;
 pub use error::ScenarioError;
 pub use events::{EventFile, EventType};
 pub use file::{

@@ -45,6 +45,7 @@ pub fn resolve_slam_config(
     };
     let c = Checker {
         cx: ErrorContext::new(label.to_string(), &text),
+        odometry: Default::default(),
     };
     let resolved = toml::from_str::<SlamList>(&text)
         .map_err(|e| locate_unknown_field(&c.cx, c.cx.from_toml(&e)))

@@ -169,15 +169,7 @@ mod tests {
     use super::*;
     use std::path::Path;
 
-    const ROOM: &str = r#"
-duration = 1.0
-walls = [
-  { from = [0.0, 0.0], to = [10.0, 0.0] },
-  { from = [0.0, 10.0], to = [10.0, 10.0] },
-  { from = [0.0, 0.0], to = [0.0, 10.0] },
-  { from = [10.0, 0.0], to = [10.0, 10.0] },
-]
-[[robots]]
+    const ROBOTS: &str = r#"[[robots]]
 name = "other"
 start = [2.0, 2.0, 0.0]
 [[robots]]
@@ -188,8 +180,8 @@ footprint = { rectangle = [0.52, 0.4] }
 "#;
 
     fn parse(sonar: &str) -> Result<Scenario, String> {
-        parse_scenario(&format!("{ROOM}{sonar}\n"), "t.toml", Path::new("."), "t")
-            .map_err(|e| e.to_string())
+        let text = format!("{}{ROBOTS}{sonar}\n", crate::scenario::TEST_ROOM);
+        parse_scenario(&text, "t.toml", Path::new("."), "t").map_err(|e| e.to_string())
     }
 
     fn sonar(table: &str) -> SonarConfig {

@@ -2,7 +2,8 @@
 //! (`--set`, sweeps, [`crate::scenario::overrides`]) edit the text and go through the same
 //! loading and validation as the file itself.
 
-use super::load::parse_scenario;
+use super::check::OdometrySource;
+use super::load::parse_scenario_with;
 use super::model::Scenario;
 use super::overrides::{Override, blame};
 use std::path::{Path, PathBuf};
@@ -15,6 +16,7 @@ pub struct Source {
     base_dir: PathBuf,
     stem: String,
     doc: DocumentMut,
+    odometry: OdometrySource,
     /// The file as it is (for sets without overrides).
     pub plain: Scenario,
 }
@@ -22,6 +24,11 @@ pub struct Source {
 impl Source {
     /// Loads and validates the file as `sim run` does, and keeps its TOML document.
     pub fn load(path: &Path) -> anyhow::Result<Source> {
+        Self::load_with(path, OdometrySource::Encoders)
+    }
+
+    /// [`Source::load`] for robots whose odometry comes from `odometry`.
+    pub fn load_with(path: &Path, odometry: OdometrySource) -> anyhow::Result<Source> {
         let label = path.display().to_string();
         let text = std::fs::read_to_string(path)
             .map_err(|e| anyhow::anyhow!("{label}: cannot read: {e}"))?;
@@ -30,7 +37,7 @@ impl Source {
             .file_stem()
             .and_then(|s| s.to_str())
             .unwrap_or("scenario");
-        let mut source = Source::from_text(&text, &label, &base_dir, stem)?;
+        let mut source = Source::from_text_with(&text, &label, &base_dir, stem, odometry)?;
         source.path = path.to_path_buf();
         Ok(source)
     }
@@ -43,7 +50,18 @@ impl Source {
         base_dir: &Path,
         stem: &str,
     ) -> anyhow::Result<Source> {
-        let plain = parse_scenario(text, label, base_dir, stem)?;
+        Self::from_text_with(text, label, base_dir, stem, OdometrySource::Encoders)
+    }
+
+    /// [`Source::from_text`] for robots whose odometry comes from `odometry`.
+    pub fn from_text_with(
+        text: &str,
+        label: &str,
+        base_dir: &Path,
+        stem: &str,
+        odometry: OdometrySource,
+    ) -> anyhow::Result<Source> {
+        let plain = parse_scenario_with(text, label, base_dir, stem, odometry)?;
         let doc: DocumentMut = text
             .parse()
             .map_err(|e| anyhow::anyhow!("{label}: not TOML: {e}"))?;
@@ -53,6 +71,7 @@ impl Source {
             path: PathBuf::from(label),
             label: label.to_string(),
             doc,
+            odometry,
             plain,
         })
     }
@@ -68,7 +87,15 @@ impl Source {
             let at = o.apply(&mut doc).map_err(|e| e.to_string())?;
             applied.push((o.clone(), at));
         }
-        parse_scenario(&doc.to_string(), &self.label, &self.base_dir, &self.stem).map_err(|e| {
+        let text = doc.to_string();
+        let parsed = parse_scenario_with(
+            &text,
+            &self.label,
+            &self.base_dir,
+            &self.stem,
+            self.odometry,
+        );
+        parsed.map_err(|e| {
             let culprits = e.key.as_deref().map_or(Vec::new(), |k| blame(&applied, k));
             let named: Vec<String> = if culprits.is_empty() {
                 overrides.iter().map(Override::describe).collect()

@@ -154,6 +154,12 @@ fn bad_input_exits_non_zero_with_a_clear_message() {
         dir.path(),
         &["x.rrd"],
     );
+    // every estimate of what? --all-estimates qualifies --trajectories
+    expect_failure(
+        &["run", "tiny.toml", "--all-estimates", "--no-rrd"],
+        dir.path(),
+        &["--all-estimates", "--trajectories"],
+    );
 }
 
 /// A run asked to save maps of a world with nothing to map fails before its first tick, not

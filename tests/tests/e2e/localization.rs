@@ -249,12 +249,15 @@ fn trajectories_are_written_for_evo() {
     sc.robots.truncate(1);
     sc.robots[0].localizers.truncate(1);
     let out = run(&sc);
-    let files = sim::formats::tum::write_trajectories(dir.path(), &out.localization).unwrap();
+    use sim::formats::tum::{Estimates, write_trajectories};
+    let files =
+        write_trajectories(dir.path(), &out.localization, Estimates::FromConvergence).unwrap();
     assert_eq!(files.len(), 2);
+    let judged = systems::eval::judged_samples(&out.localization[0].localizers[0].1).len();
     let est = std::fs::read_to_string(dir.path().join("r1/mcl.tum")).unwrap();
     let truth = std::fs::read_to_string(dir.path().join("r1/mcl.truth.tum")).unwrap();
     let (e, g): (Vec<&str>, Vec<&str>) = (est.lines().collect(), truth.lines().collect());
-    assert!(e.len() > 5 && e.len() == g.len());
+    assert!(e.len() > 5 && e.len() == g.len() && e.len() == judged);
     for (a, b) in e.iter().zip(&g) {
         let (a, b): (Vec<f64>, Vec<f64>) = (
             a.split(' ').map(|v| v.parse().unwrap()).collect(),
@@ -264,6 +267,42 @@ fn trajectories_are_written_for_evo() {
         assert_eq!(a[0], b[0], "truth at the estimate's timestamp");
         assert!((a[1] - b[1]).hypot(a[2] - b[2]) < 0.3);
     }
+}
+
+/// `--all-estimates`: a global localizer's trajectory from its first estimate, before it
+/// converged, so it can be scored over the whole run.
+#[test]
+fn every_estimate_is_written_from_the_first_when_asked() {
+    use sim::formats::tum::{Estimates, write_trajectories};
+    let mut sc = load_scenario(&bundled("hospital_patrol")).unwrap();
+    sc.duration = 20.0;
+    sc.robots.truncate(1);
+    sc.robots[0].localizers.retain(|l| l.name == "mcl_global");
+    let out = run(&sc);
+    let samples = &out.localization[0].localizers[0].1;
+    let judged = systems::eval::judged_samples(samples);
+    assert!(
+        judged.len() < samples.len(),
+        "mcl_global must converge after its first estimate in 20 s for this test"
+    );
+    let lines = |which| {
+        let dir = tempfile::tempdir().unwrap();
+        write_trajectories(dir.path(), &out.localization, which).unwrap();
+        let text = std::fs::read_to_string(dir.path().join("r1/mcl_global.tum")).unwrap();
+        let truth = std::fs::read_to_string(dir.path().join("r1/mcl_global.truth.tum")).unwrap();
+        assert_eq!(text.lines().count(), truth.lines().count());
+        let times: Vec<f64> = text
+            .lines()
+            .map(|l| l.split(' ').next().unwrap().parse().unwrap())
+            .collect();
+        times
+    };
+    let every = lines(Estimates::All);
+    assert_eq!(every.len(), samples.len());
+    assert!((every[0] - samples[0].t).abs() < 1e-6);
+    let from = lines(Estimates::FromConvergence);
+    assert_eq!(from.len(), judged.len());
+    assert!((from[0] - judged[0].t).abs() < 1e-6 && from[0] > every[0]);
 }
 
 fn with_localizer(loc: &str) -> String {
@@ -443,7 +482,8 @@ fn evo_agrees_with_our_ate_and_rpe() {
     assert_eq!(sc.robots[0].localizers.len(), 2);
     let out = run(&sc);
     let traj = dir.path().join("traj");
-    sim::formats::tum::write_trajectories(&traj, &out.localization).unwrap();
+    use sim::formats::tum::{Estimates, write_trajectories};
+    write_trajectories(&traj, &out.localization, Estimates::FromConvergence).unwrap();
     let summary = dir.path().join("summary.json");
     std::fs::write(&summary, serde_json::to_string(&out.summary).unwrap()).unwrap();
     let res = std::process::Command::new(evo.join("bin/python"))

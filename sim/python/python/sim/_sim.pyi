@@ -157,8 +157,12 @@ class Simulation:
     def trajectories(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]:
         """The finished run's estimates beside the truth: ``{robot: {localizer: array}}``,
         rows ``(t, x, y, theta, true_x, true_y, true_theta)``."""
-    def write_tum(self, dir: str | PathLike[str]) -> list[str]:
-        """Writes the finished run's trajectories as TUM files; the files written."""
+    def write_tum(
+        self, dir: str | PathLike[str], *, all_estimates: bool = False
+    ) -> list[str]:
+        """Writes the finished run's trajectories as TUM files (``DIR/<robot>/<localizer>.tum``
+        and ``.truth.tum``): from convergence on, or with ``all_estimates`` every estimate from
+        the first; the files written."""
     def reset(self, seed: int) -> None:
         """Starts again from the first tick with ``seed``, as a new simulation would."""
     def robot(self, name: str) -> Robot:

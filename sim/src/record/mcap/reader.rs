@@ -45,7 +45,7 @@ impl McapRecording {
                     if n == 0 {
                         ""
                     } else {
-                        "; a recovering read keeps them"
+                        "; `sim replay --recover` replays them"
                     }
                 ));
             }

@@ -26,6 +26,10 @@ fn describe(e: &McapError, records: usize, len: usize) -> String {
                 .into()
         }
         McapError::BadMagic => "corrupt MCAP file: no MCAP magic at the end".into(),
+        McapError::UnsupportedCompression(c) => format!(
+            "its chunks are compressed with `{c}`, which this reader does not support (it \
+             reads uncompressed, lz4 and zstd chunks)"
+        ),
         other => format!("corrupt MCAP file: {other}"),
     }
 }

@@ -232,6 +232,70 @@ fn a_cut_file_is_an_error_or_recovers_a_prefix() {
     assert_eq!(last, 40, "everything but the end magic is recovered");
 }
 
+/// A file as other writers make it (rosbag2's MCAP storage and Foxglove's Python writers
+/// compress chunks with zstd; some write none or lz4) reads back whole, whatever the chunks'
+/// compression; a compression we do not read is named, not called corruption.
+#[test]
+fn zstd_lz4_and_uncompressed_chunks_read_back() {
+    let write = |compression: Option<mcap::Compression>| {
+        let mut out = std::io::Cursor::new(Vec::new());
+        let mut w = mcap::WriteOptions::new()
+            .profile(ROS2_PROFILE)
+            .compression(compression)
+            .chunk_size(Some(4096))
+            .create(&mut out)
+            .unwrap();
+        let schema = w
+            .add_schema(
+                Odometry::NAME,
+                schema::SCHEMA_ENCODING,
+                Odometry::DEFINITION.as_bytes(),
+            )
+            .unwrap();
+        let ch = w
+            .add_channel(schema, "/odom", "cdr", &Default::default())
+            .unwrap();
+        for i in 0..200u32 {
+            let header = mcap::records::MessageHeader {
+                channel_id: ch,
+                sequence: i,
+                log_time: i as u64 * SEC / 10,
+                publish_time: i as u64 * SEC / 10,
+            };
+            let data = cdr::encode(&samples::odometry(i as f64));
+            w.write_to_known_channel(&header, &data).unwrap();
+        }
+        w.finish().unwrap();
+        drop(w);
+        out.into_inner()
+    };
+    let path = Path::new("other.mcap");
+    for c in [
+        None,
+        Some(mcap::Compression::Lz4),
+        Some(mcap::Compression::Zstd),
+    ] {
+        let bytes = write(c);
+        let r = McapRecording::from_bytes(path, &bytes, false).unwrap();
+        let got = r.decode_topic::<Odometry>("/odom").unwrap();
+        assert_eq!(got.len(), 200, "{c:?}");
+        for (i, (t, m)) in got.iter().enumerate() {
+            assert_eq!((*t, m), (i as u64 * SEC / 10, &samples::odometry(i as f64)));
+        }
+    }
+    // the same file with its chunks' compression renamed to one nobody reads
+    let mut bytes = write(Some(mcap::Compression::Zstd));
+    let at = bytes.windows(4).position(|w| w == b"zstd").unwrap();
+    bytes[at..at + 4].copy_from_slice(b"zzzz");
+    let e = McapRecording::from_bytes(path, &bytes, false)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`zzzz`") && e.contains("lz4 and zstd") && !e.contains("corrupt"),
+        "{e}"
+    );
+}
+
 #[test]
 fn garbage_and_flipped_bytes_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();

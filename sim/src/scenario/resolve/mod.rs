@@ -1,7 +1,7 @@
 //! Validation and defaults: turns a [`ScenarioFile`] into a [`Scenario`], reporting the first
 //! problem with the file, line and key.
 
-use super::check::{Checker, R, check_name};
+use super::check::{Checker, OdometrySource, R, check_name};
 use super::error::{ErrorContext, KeyPath};
 use super::file::*;
 use super::model::{RecordConfig, RobotConfig, Scenario};
@@ -18,11 +18,18 @@ pub use robot::default_diff_drive;
 use robot::resolve_robot;
 use world::World;
 
-/// Scenario text: parsed into its [`ScenarioFile`] and resolved; errors name `file_label`, the
-/// line and the key.
-pub fn resolve(text: &str, file_label: &str, base_dir: &Path, default_name: &str) -> R<Scenario> {
+/// Scenario text: parsed into its [`ScenarioFile`] and resolved, for robots whose odometry
+/// comes from `odometry`; errors name `file_label`, the line and the key.
+pub fn resolve(
+    text: &str,
+    file_label: &str,
+    base_dir: &Path,
+    default_name: &str,
+    odometry: OdometrySource,
+) -> R<Scenario> {
     let c = Checker {
         cx: ErrorContext::new(file_label.to_string(), text),
+        odometry,
     };
     let f: ScenarioFile = toml::from_str(text).map_err(|e| c.cx.from_toml(&e))?;
     resolve_file(&c, f, base_dir, default_name)
@@ -38,6 +45,7 @@ pub fn resolve_model(
 ) -> R<Scenario> {
     let c = Checker {
         cx: ErrorContext::new(label.to_string(), ""),
+        odometry: OdometrySource::Encoders,
     };
     resolve_file(&c, f, base_dir, default_name)
 }

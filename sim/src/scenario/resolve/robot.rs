@@ -2,7 +2,7 @@
 //! points it names read from the map and its places.
 
 use super::world::World;
-use crate::scenario::check::{Checker, R, check_name};
+use crate::scenario::check::{Checker, OdometrySource, R, check_name};
 use crate::scenario::error::KeyPath;
 use crate::scenario::file::*;
 use crate::scenario::model::RobotConfig;
@@ -85,20 +85,21 @@ pub(super) fn resolve_robot(
         &start,
         &localizers,
     )?;
-    if !slam.is_empty() && (laser.is_none() || encoder.is_none()) {
-        return c.err(
-            &p.key("slam"),
-            "SLAM reads the laser and the wheel odometry: give the robot \
-             `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
-        );
+    // odometry recorded on a topic (a replay) stands in for the encoders
+    let recorded = c.odometry == OdometrySource::Recorded;
+    let needs = if recorded {
+        "the laser and recorded odometry: give the robot `[robots.sensors.laser]`"
+    } else {
+        "the laser and the wheel odometry: give the robot `[robots.sensors.laser]` and \
+         `[robots.sensors.encoder]`"
+    };
+    let lacking = laser.is_none() || (encoder.is_none() && !recorded);
+    if !slam.is_empty() && lacking {
+        return c.err(&p.key("slam"), format!("SLAM reads {needs}"));
     }
     localizers.extend(slam);
-    if !localizers.is_empty() && (laser.is_none() || encoder.is_none()) {
-        return c.err(
-            &lp,
-            "localizers read the laser and the wheel odometry: give the robot \
-             `[robots.sensors.laser]` and `[robots.sensors.encoder]`",
-        );
+    if !localizers.is_empty() && lacking {
+        return c.err(&lp, format!("localizers read {needs}"));
     }
     let navigation = crate::scenario::navigation::resolve_navigation(
         c,
@@ -130,7 +131,7 @@ pub(super) fn resolve_robot(
                 "a robot with tasks is driven by its navigator: remove `behaviour`",
             );
         }
-        if encoder.is_none() {
+        if encoder.is_none() && !recorded {
             return c.err(
                 &p.key("tasks"),
                 "a robot with tasks navigates by its odometry and localization: give it `[robots.sensors.encoder]`",
@@ -152,7 +153,7 @@ pub(super) fn resolve_robot(
             &localizers,
         )?),
     };
-    if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() {
+    if matches!(behaviour, BehaviourKind::Waypoints { .. }) && encoder.is_none() && !recorded {
         return c.err(
             &bp.key("type"),
             "a `waypoints` robot navigates by its odometry: give it `[robots.sensors.encoder]`",
@@ -429,5 +430,45 @@ pub fn default_diff_drive() -> DiffDrive {
         wheel_radius: 0.1,
         max_wheel_speed: 15.0,
         max_wheel_accel: 20.0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::scenario::OdometrySource;
+    use crate::scenario::load::parse_scenario_with;
+    use std::path::Path;
+
+    const ROBOT: &str = r#"[[robots]]
+name = "r1"
+start = [5.0, 5.0, 0.0]
+behaviour = { type = "waypoints", points = [[8.0, 5.0]] }
+"#;
+
+    fn parse(sensors: &str, odometry: OdometrySource) -> Result<(), String> {
+        let room = crate::scenario::TEST_ROOM;
+        let text = format!("{room}{ROBOT}{sensors}\n[[robots.localization]]\ntype = \"mcl\"\n");
+        parse_scenario_with(&text, "t.toml", Path::new("."), "t", odometry)
+            .map(|_| ())
+            .map_err(|e| e.to_string())
+    }
+
+    /// A replay of recorded odometry needs no encoders, but localizers still need the laser.
+    #[test]
+    fn recorded_odometry_stands_in_for_the_encoders_only() {
+        let laser = "[robots.sensors.laser]";
+        let e = parse(laser, OdometrySource::Encoders).unwrap_err();
+        assert!(
+            e.contains("t.toml:") && e.contains("[robots.sensors.encoder]"),
+            "{e}"
+        );
+        parse(laser, OdometrySource::Recorded).unwrap();
+        let e = parse("", OdometrySource::Recorded).unwrap_err();
+        assert!(
+            e.contains("recorded odometry")
+                && e.contains("[robots.sensors.laser]")
+                && !e.contains("encoder"),
+            "{e}"
+        );
     }
 }
