@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every test of the workspace, in release mode, then the Python package's tests.
+# Runs every test of the workspace, in release mode, then the Python package's tests, then a
+# short fuzzing pass over every reader of user files.
 #
 # The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
 # the Python SDK's RrdReader), Foxglove's Python MCAP readers (mcap, mcap-ros2-support) and evo
@@ -52,3 +53,12 @@ python3 -m venv "$py_venv"
 echo "building and installing the Python package into a fresh virtual environment"
 "$py_venv/bin/pip" install --quiet --disable-pip-version-check "./sim/python[test,gym]"
 (cd sim/python && "$py_venv/bin/python" -m pytest -p no:cacheprovider -q tests)
+
+# Fuzzing (tests/fuzz, cargo fuzz on the stable toolchain): each reader of user files runs its
+# seeds and every input that once failed, then 15 s of coverage-guided mutations. The long run
+# is `tests/fuzz/run.sh 600` (sim/docs/reliability.md).
+if ! cargo fuzz --version 2>/dev/null | grep -q "cargo-fuzz 0.13.2"; then
+    echo "installing cargo-fuzz 0.13.2"
+    cargo install --quiet --locked cargo-fuzz --version 0.13.2
+fi
+tests/fuzz/run.sh 15

@@ -181,6 +181,10 @@ pub fn build_world_with(
     reuse: Reusable,
     cache: &MapCache,
 ) -> anyhow::Result<SimWorld> {
+    // every way of setting a length (file, --duration, a replay's stamps) ends here
+    if let Some(why) = crate::scenario::model::too_many_ticks(scenario.duration, scenario.dt) {
+        anyhow::bail!("{}: duration: {why}", scenario.name);
+    }
     let live = mode == BuildMode::Live;
     let mut times = BuildTimes::start();
     let mut world = World::new();

@@ -13,6 +13,22 @@ use systems::navigation::BehaviourKind;
 use systems::sensors::{EncoderSpec, LaserSpec};
 use systems::world::OccupancyGrid;
 
+/// The most ticks one run may have (`duration / dt`): about 58 days simulated at dt = 0.05 s.
+/// Longer runs would never end in practice; they are refused before their first tick.
+pub const MAX_TICKS: f64 = 1e8;
+
+/// Why a run of `duration` s at `dt` s per tick is too long, if it is.
+pub fn too_many_ticks(duration: f64, dt: f64) -> Option<String> {
+    let ticks = duration / dt;
+    let fits = ticks <= MAX_TICKS; // false for NaN too
+    (!fits).then(|| {
+        format!(
+            "{duration:?} s at dt = {dt:?} s is {ticks:.3e} ticks; a run has at most {MAX_TICKS:.0e} \
+             (shorten the duration or lengthen dt)"
+        )
+    })
+}
+
 /// A validated scenario with every default filled in.
 #[derive(Clone, Debug)]
 pub struct Scenario {

@@ -154,6 +154,28 @@ fn bad_input_exits_non_zero_with_a_clear_message() {
         dir.path(),
         &["x.rrd"],
     );
+    // a run that would never end is refused before its first tick: in the file (with its
+    // line), or from --duration
+    std::fs::write(
+        dir.path().join("endless.toml"),
+        ROOM.replace("seed = 3", "seed = 3\ndt = 1e-9"),
+    )
+    .unwrap();
+    expect_failure(
+        &["run", "endless.toml"],
+        dir.path(),
+        &[
+            "endless.toml:5:",
+            "dt = 1e-9 s",
+            "2.000e9 ticks",
+            "at most 1e8",
+        ],
+    );
+    expect_failure(
+        &["run", "tiny.toml", "--duration", "1e12", "--no-rrd"],
+        dir.path(),
+        &["duration", "2.000e13 ticks"],
+    );
     // every estimate of what? --all-estimates qualifies --trajectories
     expect_failure(
         &["run", "tiny.toml", "--all-estimates", "--no-rrd"],

@@ -110,19 +110,7 @@ pub fn rasterize(grid: &mut OccupancyGrid, shape: &Shape) {
 
 /// The smallest grid at `resolution` covering all shapes plus `margin`, every cell free.
 pub fn grid_for_shapes(shapes: &[Shape], resolution: f64, margin: f64) -> Option<OccupancyGrid> {
-    let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
-    for s in shapes {
-        let sb = s.bounds();
-        b = [
-            b[0].min(sb[0]),
-            b[1].min(sb[1]),
-            b[2].max(sb[2]),
-            b[3].max(sb[3]),
-        ];
-    }
-    if shapes.is_empty() {
-        return None;
-    }
+    let b = shapes_bounds(shapes)?;
     let origin = [b[0] - margin, b[1] - margin];
     let w = ((b[2] + margin - origin[0]) / resolution).ceil() as usize;
     let h = ((b[3] + margin - origin[1]) / resolution).ceil() as usize;
@@ -133,6 +121,21 @@ pub fn grid_for_shapes(shapes: &[Shape], resolution: f64, margin: f64) -> Option
         origin,
         Cell::Free,
     ))
+}
+
+/// `[min_x, min_y, max_x, max_y]` around every shape; `None` without shapes.
+pub fn shapes_bounds(shapes: &[Shape]) -> Option<[f64; 4]> {
+    let mut b = [f64::MAX, f64::MAX, f64::MIN, f64::MIN];
+    for s in shapes {
+        let sb = s.bounds();
+        b = [
+            b[0].min(sb[0]),
+            b[1].min(sb[1]),
+            b[2].max(sb[2]),
+            b[3].max(sb[3]),
+        ];
+    }
+    (!shapes.is_empty()).then_some(b)
 }
 
 #[cfg(test)]

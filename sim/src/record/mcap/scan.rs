@@ -41,6 +41,21 @@ fn has_unfinished_chunk(bytes: &[u8]) -> bool {
     bytes.windows(PLACEHOLDER.len()).any(|w| w == PLACEHOLDER)
 }
 
+/// The length an Attachment record's body needs for its header (log time, create time, name,
+/// media type, data length) and the CRC after it, when it is shorter than that. The `mcap`
+/// crate (0.26) slices past the end of such a body instead of returning an error, so it is
+/// checked first.
+fn short_attachment(body: &[u8]) -> Option<u64> {
+    let len_at = |at: usize| -> u64 {
+        body.get(at..at + 4)
+            .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64)
+    };
+    let name_end = 16 + 4 + len_at(16);
+    let media_end = name_end + 4 + len_at(name_end.min(usize::MAX as u64) as usize);
+    let needed = media_end + 8 + 4;
+    (needed > body.len() as u64).then_some(needed)
+}
+
 /// Largest decompressed chunk accepted (the writer's are about 1 MiB), so a corrupt length
 /// cannot make the reader allocate more.
 const MAX_CHUNK: usize = 1 << 28;
@@ -102,6 +117,14 @@ impl ReadState {
                     rest = &rest[n..];
                 }
                 LinearReadEvent::Record { opcode, data } => {
+                    if opcode == mcap::records::op::ATTACHMENT
+                        && let Some(needed) = short_attachment(data)
+                    {
+                        return Err(McapError::BadAttachmentLength {
+                            header: needed,
+                            available: data.len() as u64,
+                        });
+                    }
                     let record = mcap::parse_record(opcode, data)?;
                     self.records += 1;
                     if let Record::Statistics(s) = &record {

@@ -296,6 +296,42 @@ fn zstd_lz4_and_uncompressed_chunks_read_back() {
     );
 }
 
+/// An Attachment record too short for its own header (found by fuzzing: the `mcap` crate
+/// sliced past its end) is an error naming the lengths.
+#[test]
+fn an_attachment_shorter_than_its_header_is_an_error() {
+    let mut bytes = mcap::MAGIC.to_vec();
+    let record = |bytes: &mut Vec<u8>, op: u8, body: &[u8]| {
+        bytes.push(op);
+        bytes.extend_from_slice(&(body.len() as u64).to_le_bytes());
+        bytes.extend_from_slice(body);
+    };
+    let mut header = Vec::new();
+    for s in ["ros2", "hand-made"] {
+        header.extend_from_slice(&(s.len() as u32).to_le_bytes());
+        header.extend_from_slice(s.as_bytes());
+    }
+    record(&mut bytes, mcap::records::op::HEADER, &header);
+    for body in [vec![0u8; 12], vec![0u8; 35], {
+        // a name 200 bytes long in a 40-byte body
+        let mut b = vec![0u8; 40];
+        b[16..20].copy_from_slice(&200u32.to_le_bytes());
+        b
+    }] {
+        let mut file = bytes.clone();
+        record(&mut file, mcap::records::op::ATTACHMENT, &body);
+        record(&mut file, mcap::records::op::FOOTER, &[0u8; 20]);
+        file.extend_from_slice(mcap::MAGIC);
+        let e = McapRecording::from_bytes(Path::new("short.mcap"), &file, false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("short.mcap: corrupt MCAP file: Attachment length"),
+            "{e}"
+        );
+    }
+}
+
 #[test]
 fn garbage_and_flipped_bytes_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();

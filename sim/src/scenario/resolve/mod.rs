@@ -8,7 +8,7 @@ use super::model::{RecordConfig, RobotConfig, Scenario};
 use crate::scenario::outdoor::RoadsConfig;
 use std::collections::BTreeMap;
 use std::path::Path;
-use systems::world::shapes::{Shape, grid_for_shapes, rasterize};
+use systems::world::shapes::{Shape, rasterize, shapes_bounds};
 use systems::world::{Cell, OccupancyGrid, load_map};
 
 mod robot;
@@ -193,6 +193,9 @@ fn resolve_header(c: &Checker, root: &KeyPath, f: &ScenarioFile, default_name: &
         return c.err(root, "missing key `duration` (simulated seconds)");
     };
     let duration = c.positive(&root.key("duration"), duration)?;
+    if let Some(why) = super::model::too_many_ticks(duration, dt) {
+        return c.err(&root.key("duration"), why);
+    }
     Ok(Header {
         name,
         seed: f.seed.unwrap_or(0),
@@ -263,13 +266,14 @@ fn resolve_grid(
             let res = c.opt_positive(&mpath.key("resolution"), resolution, default_res)?;
             let outdoor = roads.map(|r| (r.graph.bounds(), r.margin));
             match grid_for_world(shapes, outdoor, res) {
-                Some(g) => g,
-                None => {
+                Ok(Some(g)) => g,
+                Ok(None) => {
                     return c.err(
                         root,
                         "the world is empty: give `map.file` (a ROS map_server YAML), `[roads]` or walls, boxes or discs",
                     );
                 }
+                Err(why) => return c.err(&mpath, why),
             }
         }
     };
@@ -279,7 +283,7 @@ fn resolve_grid(
             "the resolution comes from the map file; remove this key",
         );
     }
-    if grid.width * grid.height > 400_000_000 {
+    if grid.width * grid.height > MAX_CELLS {
         return c.err(&mpath, "the map has more than 400 million cells");
     }
     for s in shapes {
@@ -319,8 +323,19 @@ fn grid_for_world(
     shapes: &[Shape],
     roads: Option<([f64; 4], f64)>,
     resolution: f64,
-) -> Option<OccupancyGrid> {
-    let from_shapes = grid_for_shapes(shapes, resolution, 2.0).map(|g| g.bounds());
+) -> Result<Option<OccupancyGrid>, String> {
+    // the bounds of the grid `grid_for_shapes` would make with a 2 m margin, cells included
+    let from_shapes = shapes_bounds(shapes).map(|b| {
+        let origin = [b[0] - 2.0, b[1] - 2.0];
+        let w = ((b[2] + 2.0 - origin[0]) / resolution).ceil().max(1.0);
+        let h = ((b[3] + 2.0 - origin[1]) / resolution).ceil().max(1.0);
+        [
+            origin[0],
+            origin[1],
+            origin[0] + w * resolution,
+            origin[1] + h * resolution,
+        ]
+    });
     let from_roads = roads.map(|(b, m)| [b[0] - m, b[1] - m, b[2] + m, b[3] + m]);
     let b = match (from_shapes, from_roads) {
         (Some(a), Some(b)) => [
@@ -330,15 +345,37 @@ fn grid_for_world(
             a[3].max(b[3]),
         ],
         (Some(a), None) | (None, Some(a)) => a,
-        (None, None) => return None,
+        (None, None) => return Ok(None),
     };
-    let w = ((b[2] - b[0]) / resolution).ceil().max(1.0) as usize;
-    let h = ((b[3] - b[1]) / resolution).ceil().max(1.0) as usize;
-    Some(OccupancyGrid::new(
+    // sized before allocating: a far-away shape or road reference must not take the memory
+    let (w, h) = ((b[2] - b[0]) / resolution, (b[3] - b[1]) / resolution);
+    let (w, h) = (w.ceil().max(1.0), h.ceil().max(1.0));
+    let fits = w * h <= MAX_CELLS as f64; // false for NaN too
+    if !fits {
+        return Err(format!(
+            "the world spans {:.0} × {:.0} m (from ({:.0}, {:.0}) to ({:.0}, {:.0}): walls, boxes, \
+             discs and roads), {:.3e} cells at {resolution} m; at most 400 million",
+            b[2] - b[0],
+            b[3] - b[1],
+            b[0],
+            b[1],
+            b[2],
+            b[3],
+            w * h
+        ));
+    }
+    let (w, h) = (w as usize, h as usize);
+    Ok(Some(OccupancyGrid::new(
         w,
         h,
         resolution,
         [b[0], b[1]],
         Cell::Free,
-    ))
+    )))
 }
+
+/// The most cells a scenario's map may have (400 MB of cells, before the distance fields).
+const MAX_CELLS: usize = 400_000_000;
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Fuzzes every reader of user files with cargo fuzz (libFuzzer, coverage-guided, built on the
+# stable toolchain with `--sanitizer none`).
+#
+#   tests/fuzz/run.sh [SECONDS] [TARGET...]     default: 600 s per target, every target
+#
+# Each target first runs every input of its seeds (tests/fuzz/seeds/<target>/: our own files
+# and every input that once failed), then mutates its working corpus (tests/fuzz/corpus/
+# <target>/, not committed) for SECONDS. A failure is a panic or abort, an input that takes
+# more than 10 s, or an allocation over 2 GB (malloc_limit_mb); libFuzzer then writes the input
+# to tests/fuzz/artifacts/<target>/ and this script exits non-zero. Fix the cause, then copy
+# the input into seeds/<target>/ so it is replayed on every run.
+#
+# Needs: cargo install cargo-fuzz (0.13). CARGO_TARGET_DIR is honoured.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+seconds="${1:-600}"
+shift || true
+targets=("$@")
+if [ ${#targets[@]} -eq 0 ]; then
+    targets=(scenario overrides map places roads carmen scans mcap batch)
+fi
+cd "$here/../.."
+cargo fuzz build --sanitizer none --fuzz-dir tests/fuzz -O
+log="$(mktemp)"
+trap 'rm -f "$log"' EXIT
+for t in "${targets[@]}"; do
+    mkdir -p "tests/fuzz/corpus/$t" "tests/fuzz/artifacts/$t"
+    echo "== $t: its seeds, then ${seconds} s of fuzzing"
+    status=0
+    cargo fuzz run --sanitizer none --fuzz-dir tests/fuzz -O "$t" \
+        "tests/fuzz/corpus/$t" "tests/fuzz/seeds/$t" -- \
+        -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -malloc_limit_mb=2048 \
+        -max_len=262144 -print_final_stats=1 \
+        -artifact_prefix="tests/fuzz/artifacts/$t/" >"$log" 2>&1 || status=$?
+    grep -E "^stat::(number_of_executed_units|peak_rss_mb)|^INFO: seed corpus|^#[0-9]+ +DONE" "$log" || true
+    if [ "$status" -ne 0 ] || [ -n "$(ls -A "tests/fuzz/artifacts/$t")" ]; then
+        failed=1
+        grep -v -e '^\s*\[' -e '^Output of' "$log" | cut -c1-300 | tail -40 >&2
+        echo "$t: failed (exit $status); inputs in tests/fuzz/artifacts/$t" >&2
+    fi
+done
+exit "${failed:-0}"
