@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     restore_sigpipe();
+    sim::run::interrupt::ignore_file_size_signal();
     let cli = Cli::parse();
     sim::cache::set_process_cache(sim::cache::from_env(cli.no_cache));
     match dispatch(cli.command) {

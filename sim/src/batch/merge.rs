@@ -194,6 +194,20 @@ pub fn merge_command(a: &MergeArgs) -> anyhow::Result<BatchReport> {
         }
     }
     check_complete(&manifests)?;
+    // every shard is here with its number of runs: jobs and sets are numbered below that
+    let jobs = rows.len() as u64;
+    if let Some((r, dir)) = rows
+        .iter()
+        .find(|(r, _)| get(r, "job") >= jobs || get(r, "set") >= jobs)
+    {
+        anyhow::bail!(
+            "{}: job {} of parameter set {} is not in a batch of {jobs} runs: the file is \
+             edited or from another batch",
+            dir.join("runs.jsonl").display(),
+            get(r, "job"),
+            get(r, "set")
+        );
+    }
     let rows: Vec<Row> = rows.into_iter().map(|(r, _)| r).collect();
     std::fs::create_dir_all(&a.out)
         .map_err(|e| anyhow::anyhow!("{}: cannot create the folder: {e}", a.out.display()))?;

@@ -25,6 +25,17 @@ pub fn install_handler() -> anyhow::Result<()> {
     .map_err(|e| anyhow::anyhow!("cannot install the Ctrl-C handler: {e}"))
 }
 
+/// Makes a file-size limit (`ulimit -f`, `prlimit --fsize`) an error of the write that passes
+/// it, which names its file, instead of SIGXFSZ killing the process with every other output
+/// unwritten. Call once, from `main`.
+pub fn ignore_file_size_signal() {
+    // SAFETY: setting SIGXFSZ's disposition to SIG_IGN installs no handler code; writes past
+    // the limit then fail with EFBIG (POSIX `write`).
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
 /// True once a stop was asked for.
 pub fn requested() -> bool {
     STOP.load(Ordering::Relaxed)

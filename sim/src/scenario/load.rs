@@ -7,19 +7,36 @@ use std::path::{Path, PathBuf};
 
 /// Loads and validates a scenario file.
 pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
-    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
-        file: path.display().to_string(),
-        line: None,
-        column: None,
-        key: None,
-        message: format!("cannot read: {e}"),
-    })?;
+    let text = read_scenario_text(path)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let stem = path
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("scenario");
     parse_scenario(&text, &path.display().to_string(), &base, stem)
+}
+
+/// A scenario file's text; where it is not UTF-8, the error gives the line and column.
+pub fn read_scenario_text(path: &Path) -> Result<String, ScenarioError> {
+    let error = |line, column, message| ScenarioError {
+        file: path.display().to_string(),
+        line,
+        column,
+        key: None,
+        message,
+    };
+    let bytes = std::fs::read(path).map_err(|e| error(None, None, format!("cannot read: {e}")))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+        let start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let column = String::from_utf8_lossy(&good[start..]).chars().count() + 1;
+        error(
+            Some(line),
+            Some(column),
+            "not UTF-8 text (a scenario file is TOML, which is UTF-8)".into(),
+        )
+    })
 }
 
 /// Parses and validates scenario text; relative paths resolve against `base_dir`.

@@ -30,8 +30,7 @@ impl Source {
     /// [`Source::load`] for robots whose odometry comes from `odometry`.
     pub fn load_with(path: &Path, odometry: OdometrySource) -> anyhow::Result<Source> {
         let label = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| anyhow::anyhow!("{label}: cannot read: {e}"))?;
+        let text = super::load::read_scenario_text(path)?;
         let base_dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let stem = path
             .file_stem()

@@ -240,6 +240,28 @@ fn merge_refuses_missing_shards() {
     assert!(!dir.path().join("m").exists());
 }
 
+/// A row whose parameter set is far beyond the batch's (found by fuzzing: the merge then
+/// aggregated 54 billion empty sets and never ended) is an error naming the file.
+#[test]
+fn merge_refuses_rows_outside_the_batch() {
+    let dir = room();
+    shard(dir.path(), "tiny.toml", "0.1", "0/2", "s0");
+    shard(dir.path(), "tiny.toml", "0.1", "1/2", "s1");
+    let rows = dir.path().join("s1/runs.jsonl");
+    let text = std::fs::read_to_string(&rows).unwrap();
+    assert!(text.contains("\"set\":0,"), "{text}");
+    std::fs::write(&rows, text.replace("\"set\":0,", "\"set\":54505553469,")).unwrap();
+    expect_failure(
+        &["batch-merge", "m", "s0", "s1"],
+        dir.path(),
+        &[
+            "s1/runs.jsonl",
+            "parameter set 54505553469",
+            "batch of 3 runs",
+        ],
+    );
+}
+
 /// `sim batch ARGS` fails without a panic; the message after `error: `.
 fn batch_error(args: &[&str]) -> String {
     let dir = tempfile::tempdir().unwrap();

@@ -176,6 +176,17 @@ fn bad_input_exits_non_zero_with_a_clear_message() {
         dir.path(),
         &["duration", "2.000e13 ticks"],
     );
+    // a file that is not UTF-8: where the first bad byte is
+    std::fs::write(
+        dir.path().join("latin1.toml"),
+        b"duration = 1.0\n# caf\xe9\n",
+    )
+    .unwrap();
+    expect_failure(
+        &["run", "latin1.toml"],
+        dir.path(),
+        &["latin1.toml:2:6:", "not UTF-8"],
+    );
     // every estimate of what? --all-estimates qualifies --trajectories
     expect_failure(
         &["run", "tiny.toml", "--all-estimates", "--no-rrd"],
@@ -243,5 +254,37 @@ fn a_closed_pipe_ends_the_output_quietly() {
         Some(libc::SIGPIPE),
         "{:?} {stderr}",
         out.status
+    );
+}
+
+/// Outputs that cannot be written: a full disk (`/dev/full`) and a file-size limit reached
+/// mid-run (`ulimit -f`, which would otherwise kill the process with SIGXFSZ) end the command
+/// with an error naming the file and the OS's reason, and a non-zero exit code.
+#[test]
+fn a_full_disk_or_a_file_size_limit_is_an_error_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    for flag in ["--mcap", "--rrd", "--carmen-out"] {
+        let mut args = vec!["run", "tiny.toml", flag, "/dev/full"];
+        if flag != "--rrd" {
+            args.push("--no-rrd");
+        }
+        expect_failure(&args, dir.path(), &["/dev/full", "No space left on device"]);
+    }
+    // 100 blocks of 512 bytes: the MCAP of a 20 s run passes it mid-run
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -f 100 && exec {} run tiny.toml --duration 20 --no-rrd --quiet --mcap big.mcap",
+            env!("CARGO_BIN_EXE_sim")
+        ))
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("big.mcap") && err.contains("File too large") && !err.contains("panicked"),
+        "{err}"
     );
 }

@@ -146,6 +146,15 @@ pub fn load_map(yaml_path: &Path) -> Result<OccupancyGrid, MapError> {
     let image_path = yaml_path.parent().unwrap_or(Path::new(".")).join(&y.image);
     let img = image::open(&image_path)
         .map_err(|e| match e {
+            // the header was read: the pixels stop short of what it announced
+            image::ImageError::IoError(source)
+                if source.kind() == std::io::ErrorKind::UnexpectedEof =>
+            {
+                MapError::Image {
+                    path: image_path.clone(),
+                    message: "the image ends before its last pixel (the file is cut short)".into(),
+                }
+            }
             image::ImageError::IoError(source) => MapError::Read {
                 path: image_path.clone(),
                 source,
@@ -295,6 +304,17 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = write_fixture(dir.path(), yaml, &asymmetric_pgm());
         load_map(&p).unwrap_err().to_string()
+    }
+
+    /// A PGM cut short after its header is an image error saying so, not a read error.
+    #[test]
+    fn a_cut_image_says_it_is_cut_short() {
+        let dir = tempfile::tempdir().unwrap();
+        let pgm = asymmetric_pgm();
+        let yaml = "image: m.pgm\nresolution: 1\norigin: [0,0,0]\n";
+        let p = write_fixture(dir.path(), yaml, &pgm[..pgm.len() - 2]);
+        let e = load_map(&p).unwrap_err().to_string();
+        assert!(e.contains("m.pgm") && e.contains("cut short"), "{e}");
     }
 
     #[test]

@@ -140,8 +140,9 @@ impl FileWriter {
         }
     }
 
-    fn error(&self, what: &str, e: impl std::fmt::Display) -> anyhow::Error {
-        anyhow!("{}: cannot {what}: {e}", self.path.display())
+    /// The error of `what`, with its causes (the OS error under the mcap crate's I/O error).
+    fn error(&self, what: &str, e: impl Into<anyhow::Error>) -> anyhow::Error {
+        anyhow!("{}: cannot {what}: {:#}", self.path.display(), e.into())
     }
 
     fn message(&mut self, channel: u16, log_time: u64, data: &[u8]) -> anyhow::Result<()> {
