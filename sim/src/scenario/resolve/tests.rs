@@ -43,3 +43,59 @@ fn roads_far_from_their_reference_point_are_refused_before_allocating() {
         "{e}"
     );
 }
+
+/// The world's grid sized from the shapes' bounds, without allocating, has the cells of the
+/// grid that `grid_for_shapes` used to allocate only to measure them (the plain version).
+#[test]
+fn the_grid_sized_without_allocating_is_the_one_measured_before() {
+    use super::grid_for_world;
+    use systems::world::shapes::{Shape, grid_for_shapes};
+    let plain = |shapes: &[Shape], roads: Option<([f64; 4], f64)>, res: f64| {
+        let from_shapes = grid_for_shapes(shapes, res, 2.0).map(|g| g.bounds());
+        let from_roads = roads.map(|(b, m)| [b[0] - m, b[1] - m, b[2] + m, b[3] + m]);
+        let b = match (from_shapes, from_roads) {
+            (Some(a), Some(b)) => [
+                a[0].min(b[0]),
+                a[1].min(b[1]),
+                a[2].max(b[2]),
+                a[3].max(b[3]),
+            ],
+            (Some(a), None) | (None, Some(a)) => a,
+            (None, None) => return None,
+        };
+        let w = ((b[2] - b[0]) / res).ceil().max(1.0) as usize;
+        let h = ((b[3] - b[1]) / res).ceil().max(1.0) as usize;
+        Some((w, h, [b[0], b[1]]))
+    };
+    let shapes = [
+        Shape::Box {
+            center: [26.0, 59.5],
+            size: [40.0, 15.0],
+            yaw: 0.3,
+        },
+        Shape::Disc {
+            center: [-60.0, 80.0],
+            radius: 0.5,
+        },
+        Shape::Disc {
+            center: [118.03, 88.1],
+            radius: 0.4,
+        },
+        Shape::Box {
+            center: [0.013, -7.77],
+            size: [0.1, 3.3],
+            yaw: 1.0,
+        },
+    ];
+    let roads = [None, Some(([-151.3, -130.7, 160.2, 120.9], 10.0))];
+    for n in 0..=shapes.len() {
+        for &r in &roads {
+            for res in [0.05, 0.1, 0.2, 0.3, 0.07] {
+                let got = grid_for_world(&shapes[..n], r, res)
+                    .unwrap()
+                    .map(|g| (g.width, g.height, g.origin));
+                assert_eq!(got, plain(&shapes[..n], r, res), "{n} shapes, {r:?}, {res}");
+            }
+        }
+    }
+}
