@@ -49,11 +49,12 @@ fn file(name: &str, data: &[u8]) -> PathBuf {
     p
 }
 
-/// Splits `data` at the first line `---` into two parts.
-fn two_parts(data: &[u8]) -> (&[u8], &[u8]) {
-    const SEP: &[u8] = b"\n---\n";
-    match data.windows(SEP.len()).position(|w| w == SEP) {
-        Some(i) => (&data[..i], &data[i + SEP.len()..]),
+/// Splits `data` at the first line `sep` into two parts (the second empty without one).
+fn two_parts<'a>(data: &'a [u8], sep: &str) -> (&'a [u8], &'a [u8]) {
+    let sep = format!("\n{sep}\n");
+    let sep = sep.as_bytes();
+    match data.windows(sep.len()).position(|w| w == sep) {
+        Some(i) => (&data[..i], &data[i + sep.len()..]),
         None => (data, &[]),
     }
 }
@@ -120,7 +121,7 @@ type = "mcl"
 
 /// A map_server YAML, then a line `---`, then its image (PGM, or PNG when it starts so).
 pub fn map(data: &[u8]) {
-    let (yaml, image) = two_parts(data);
+    let (yaml, image) = two_parts(data, "---");
     let name = if image.starts_with(b"\x89PNG") {
         "map.png"
     } else {
@@ -205,14 +206,10 @@ pub fn mcap(data: &[u8]) {
 /// Two shards of a batch for `sim batch-merge`: each a `batch.json`, `---`, a `runs.jsonl`,
 /// the shards themselves separated by a line `===`.
 pub fn batch(data: &[u8]) {
-    const SEP: &[u8] = b"\n===\n";
-    let (a, b) = match data.windows(SEP.len()).position(|w| w == SEP) {
-        Some(i) => (&data[..i], &data[i + SEP.len()..]),
-        None => (data, &b""[..]),
-    };
+    let (a, b) = two_parts(data, "===");
     let mut shards = Vec::new();
     for (k, shard) in [a, b].into_iter().enumerate() {
-        let (manifest, rows) = two_parts(shard);
+        let (manifest, rows) = two_parts(shard, "---");
         let dir = scratch().join(format!("shard{k}"));
         std::fs::create_dir_all(&dir).expect("a shard folder");
         std::fs::write(dir.join("batch.json"), manifest).expect("batch.json");

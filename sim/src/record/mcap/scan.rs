@@ -51,7 +51,7 @@ fn short_attachment(body: &[u8]) -> Option<u64> {
             .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64)
     };
     let name_end = 16 + 4 + len_at(16);
-    let media_end = name_end + 4 + len_at(name_end.min(usize::MAX as u64) as usize);
+    let media_end = name_end + 4 + len_at(name_end as usize);
     let needed = media_end + 8 + 4;
     (needed > body.len() as u64).then_some(needed)
 }
