@@ -49,6 +49,11 @@ pub struct BatchArgs {
     /// major, seeds minor. For Slurm job arrays and Kubernetes indexed jobs.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
+    /// Run only the jobs the output folder has no successful row for (a batch that was
+    /// stopped or killed, runs that failed), with the arguments it was started with; the
+    /// folder's files then hold every run.
+    #[arg(long)]
+    pub resume: bool,
     /// Also write one Rerun recording per run into the output folder
     /// (`set<S>-seed<N>.rrd`).
     #[arg(long)]

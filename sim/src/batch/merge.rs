@@ -5,9 +5,7 @@
 //! missing shard and an output folder that is one of the shards are errors.
 
 use super::output::{self, Row};
-use super::{BatchReport, aggregate, manifest};
-use serde::de::{Deserializer, MapAccess, Visitor};
-use serde_json::Value as Json;
+use super::{BatchReport, aggregate, journal, manifest};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -23,58 +21,21 @@ pub struct MergeArgs {
     pub quiet: bool,
 }
 
-/// A JSON object with its keys in file order.
-struct Ordered(Row);
-
-impl<'de> serde::Deserialize<'de> for Ordered {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        struct V;
-        impl<'de> Visitor<'de> for V {
-            type Value = Ordered;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a JSON object")
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut m: A) -> Result<Ordered, A::Error> {
-                let mut row = Row::new();
-                while let Some((k, v)) = m.next_entry::<String, Json>()? {
-                    row.push((k, v));
-                }
-                Ok(Ordered(row))
-            }
-        }
-        d.deserialize_map(V)
-    }
-}
-
 fn read_rows(dir: &Path) -> anyhow::Result<Vec<Row>> {
-    let path = dir.join("runs.jsonl");
+    let path = dir.join(journal::RUNS);
     let text = std::fs::read_to_string(&path)
         .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
     text.lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
         .map(|(i, l)| {
-            let Ordered(row) = serde_json::from_str(l)
-                .map_err(|e| anyhow::anyhow!("{}:{}: not a run row: {e}", path.display(), i + 1))?;
-            for k in ["job", "set"] {
-                if !row.iter().any(|(c, v)| c == k && v.is_u64()) {
-                    anyhow::bail!(
-                        "{}:{}: no `{k}` number: not a runs.jsonl of sim batch",
-                        path.display(),
-                        i + 1
-                    );
-                }
-            }
-            Ok(row)
+            journal::parse_row(l).map_err(|e| anyhow::anyhow!("{}:{}: {e}", path.display(), i + 1))
         })
         .collect()
 }
 
 fn get(row: &Row, k: &str) -> u64 {
-    row.iter()
-        .find(|(c, _)| c == k)
-        .and_then(|(_, v)| v.as_u64())
-        .unwrap_or(0)
+    journal::number(row, k)
 }
 
 /// Refuses an output folder that is one of the shards (merging would overwrite its files).
@@ -171,7 +132,8 @@ pub fn merge_command(a: &MergeArgs) -> anyhow::Result<BatchReport> {
         if shard_rows.len() != m.shard_runs() {
             anyhow::bail!(
                 "{}: {} runs, but shard {}/{} of a batch of {} jobs has {}: the file is \
-                 incomplete or edited",
+                 incomplete (a shard that was stopped: run it again with the same arguments \
+                 and --resume) or edited",
                 dir.join("runs.jsonl").display(),
                 shard_rows.len(),
                 m.shard,

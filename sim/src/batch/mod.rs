@@ -9,6 +9,7 @@
 
 pub mod aggregate;
 pub mod args;
+pub mod journal;
 pub mod manifest;
 pub mod merge;
 pub mod output;
@@ -24,7 +25,9 @@ use crate::run::summary::Summary;
 use crate::run::{RunOptions, run_scenario};
 use crate::scenario::Scenario;
 use crate::scenario::scenario_path;
+use journal::Journal;
 use output::Row;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -173,15 +176,18 @@ fn describe_set(b: &Batch, set: usize) -> String {
     }
 }
 
-/// Runs the batch's jobs: the summaries (or errors) in job order, with wall times.
+/// Runs the batch's jobs but those in `kept` (already run, by a batch now resumed): the
+/// summaries (or errors) in job order, with wall times. `journal` gets each one's row as it
+/// ends.
 pub fn run_batch(
     b: &Batch,
     workers: usize,
     threads: usize,
     rrd_dir: Option<&Path>,
     show_progress: bool,
+    (journal, kept): (Option<&Journal>, &BTreeMap<usize, Row>),
 ) -> anyhow::Result<Vec<runner::Finished<Summary>>> {
-    let bar = runner::progress_bar(b.jobs.len(), show_progress);
+    let bar = runner::progress_bar(b.jobs.len() - kept.len(), show_progress);
     let mut failed = Vec::new();
     let mut runnable = Vec::new();
     for (set, s) in b.scenarios.iter().enumerate() {
@@ -194,7 +200,7 @@ pub fn run_batch(
             );
         }
     }
-    for j in &b.jobs {
+    for j in b.jobs.iter().filter(|j| !kept.contains_key(&j.index)) {
         match &b.scenarios[j.set] {
             Some(Ok(_)) => runnable.push(*j),
             Some(Err(e)) => failed.push(runner::Finished {
@@ -207,6 +213,9 @@ pub fn run_batch(
     }
     bar.inc(failed.len() as u64);
     bar.set_message(format!("{} failed", failed.len()));
+    if let Some(j) = journal {
+        j.append(&rows(b, &failed));
+    }
     let done = runner::run_jobs(
         &runnable,
         workers,
@@ -233,6 +242,11 @@ pub fn run_batch(
                 ..Default::default()
             };
             Ok(run_scenario(&sc, &opts)?.summary)
+        },
+        |f| {
+            if let Some(j) = journal {
+                j.append(&rows(b, std::slice::from_ref(f)));
+            }
         },
     )?;
     bar.finish_and_clear();
@@ -284,8 +298,33 @@ impl Batch {
         rrd_dir: Option<&Path>,
         show_progress: bool,
     ) -> anyhow::Result<BatchResults> {
-        let runs = run_batch(self, workers, threads, rrd_dir, show_progress)?;
-        let rows = rows(self, &runs);
+        let none = BTreeMap::new();
+        self.execute_with(workers, threads, rrd_dir, show_progress, (None, &none))
+    }
+
+    /// [`Batch::execute`], with each row appended to `journal` as its run ends, and the jobs
+    /// of `kept` not run again: their rows (of a batch now resumed) join the results.
+    pub fn execute_with(
+        &self,
+        workers: usize,
+        threads: usize,
+        rrd_dir: Option<&Path>,
+        show_progress: bool,
+        (journal, kept): (Option<&Journal>, &BTreeMap<usize, Row>),
+    ) -> anyhow::Result<BatchResults> {
+        let runs = run_batch(
+            self,
+            workers,
+            threads,
+            rrd_dir,
+            show_progress,
+            (journal, kept),
+        )?;
+        let mut rows = rows(self, &runs);
+        if !kept.is_empty() {
+            rows.extend(kept.values().cloned());
+            rows.sort_by_key(|r| journal::number(r, "job"));
+        }
         let columns = if rows.is_empty() {
             // a shard without jobs: the header of the run columns alone
             let none = runner::Job {
@@ -299,7 +338,7 @@ impl Batch {
         };
         let stats = aggregate::aggregate(self.sets.len(), &columns, &rows);
         let table = aggregate::table(&stats);
-        let failed = runs.iter().filter(|f| f.result.is_err()).count();
+        let failed = rows.iter().filter(|r| !journal::succeeded(r)).count();
         Ok(BatchResults {
             runs,
             rows,
@@ -346,15 +385,48 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
             runner::worker_count(a.jobs, b.jobs.len())
         );
     }
+    let kept = if a.resume {
+        journal::finished_rows(&out_dir, &b.manifest, &b.jobs)?
+    } else {
+        BTreeMap::new()
+    };
+    // From the start the folder says which batch it holds, and its rows grow as runs end: a
+    // batch that is killed can be resumed.
+    for stale in ["runs.csv", "aggregate.csv"] {
+        match std::fs::remove_file(out_dir.join(stale)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                anyhow::bail!("{}: cannot replace: {e}", out_dir.join(stale).display())
+            }
+            _ => {}
+        }
+    }
+    b.manifest.write(&out_dir)?;
+    let journal = Journal::start(&out_dir, &kept.values().cloned().collect::<Vec<_>>())?;
+    if a.resume && !a.quiet {
+        eprintln!(
+            "resuming: {} of {} runs are done, {} to run",
+            kept.len(),
+            b.jobs.len(),
+            b.jobs.len() - kept.len()
+        );
+    }
     let rrd_dir = a.rrd.then_some(out_dir.as_path());
-    let r = b.execute(a.jobs, a.threads, rrd_dir, !a.quiet)?;
+    let r = b.execute_with(
+        a.jobs,
+        a.threads,
+        rrd_dir,
+        !a.quiet,
+        (Some(&journal), &kept),
+    )?;
+    if let Err(e) = journal.finish() {
+        eprintln!("warning: {e:#} (the rows are written again below)");
+    }
     if r.rows.is_empty() {
         eprintln!("warning: this shard has no jobs (the batch has fewer than its number)");
     }
     output::write_csv(&out_dir.join("runs.csv"), &r.columns, &r.rows)?;
-    output::write_jsonl(&out_dir.join("runs.jsonl"), &r.rows)?;
+    output::write_jsonl(&out_dir.join(journal::RUNS), &r.rows)?;
     aggregate::write_aggregate(&out_dir.join("aggregate.csv"), &r.stats)?;
-    b.manifest.write(&out_dir)?;
     let page = if a.report {
         Some(crate::report::write_batch(
             &out_dir, &b.name, &r.rows, &r.stats,
@@ -368,7 +440,7 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
         println!(
             "{} runs, {} failed, in {wall_s:.1} s; runs.csv, runs.jsonl, aggregate.csv and \
              batch.json written to {}",
-            r.runs.len(),
+            r.rows.len(),
             r.failed,
             out_dir.display()
         );
@@ -378,7 +450,7 @@ pub fn batch_command(a: &BatchArgs) -> anyhow::Result<BatchReport> {
     }
     Ok(BatchReport {
         out_dir,
-        runs: r.runs.len(),
+        runs: r.rows.len(),
         failed: r.failed,
         rows: r.rows,
         table: r.table,

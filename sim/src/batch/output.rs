@@ -234,13 +234,18 @@ pub fn write_jsonl(path: &Path, rows: &[Row]) -> anyhow::Result<()> {
     let f = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
     let mut w = std::io::BufWriter::new(f);
     for r in rows {
-        let fields: Vec<String> = r
-            .iter()
-            .map(|(k, v)| format!("{}:{}", Json::String(k.clone()), v))
-            .collect();
-        writeln!(w, "{{{}}}", fields.join(",")).map_err(|e| io_err(path, e))?;
+        writeln!(w, "{}", row_line(r)).map_err(|e| io_err(path, e))?;
     }
     w.flush().map_err(|e| io_err(path, e))
+}
+
+/// A row as one line of JSON (without the newline), keys in row order.
+pub fn row_line(r: &Row) -> String {
+    let fields: Vec<String> = r
+        .iter()
+        .map(|(k, v)| format!("{}:{}", Json::String(k.clone()), v))
+        .collect();
+    format!("{{{}}}", fields.join(","))
 }
 
 #[cfg(test)]

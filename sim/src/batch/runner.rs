@@ -112,8 +112,8 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
 }
 
 /// Runs `work` on every job with `workers` threads (0 = one per core; never more than the jobs),
-/// catching errors and panics; results come back in job order. `failed_before` runs already counted as failed
-/// (shown on the bar).
+/// catching errors and panics; `done` sees each job as it ends, and the results come back in
+/// job order. `failed_before` runs already counted as failed (shown on the bar).
 pub fn run_jobs<T: Send>(
     jobs: &[Job],
     workers: usize,
@@ -121,6 +121,7 @@ pub fn run_jobs<T: Send>(
     failed_before: usize,
     describe: impl Fn(&Job) -> String + Sync,
     work: impl Fn(&Job) -> anyhow::Result<T> + Sync,
+    ended: impl Fn(&Finished<T>) + Sync,
 ) -> anyhow::Result<Vec<Finished<T>>> {
     if jobs.is_empty() {
         return Ok(Vec::new());
@@ -155,6 +156,7 @@ pub fn run_jobs<T: Send>(
                 result,
                 wall_s: started.elapsed().as_secs_f64(),
             };
+            ended(&f);
             // a worker that panicked outside `work` cannot have poisoned this lock while holding it
             if let Ok(mut d) = done.lock() {
                 d.push(f);
@@ -247,6 +249,7 @@ mod tests {
     fn errors_and_panics_do_not_stop_the_others() {
         let jobs = plan_jobs(1, 0..6, None).unwrap();
         let bar = ProgressBar::hidden();
+        let seen = Mutex::new(Vec::new());
         let out = run_jobs(
             &jobs,
             2,
@@ -258,8 +261,13 @@ mod tests {
                 4 => panic!("seed four"),
                 s => Ok(s * 10),
             },
+            |f| seen.lock().unwrap().push(f.job.index),
         )
         .unwrap();
+        // each job was seen as it ended, failed ones too
+        let mut seen = seen.into_inner().unwrap();
+        seen.sort();
+        assert_eq!(seen, [0, 1, 2, 3, 4, 5]);
         let got: Vec<Result<u64, String>> = out.into_iter().map(|f| f.result).collect();
         assert_eq!(
             got,

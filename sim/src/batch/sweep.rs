@@ -38,6 +38,7 @@ impl Sweep {
                 out: None,
                 shard: None,
                 rrd: false,
+                resume: false,
                 report: false,
                 quiet: true,
             },

@@ -61,6 +61,7 @@ pub fn run_batch_bench(o: &BenchBatchArgs) -> anyhow::Result<BatchBenchRow> {
         out: None,
         shard: None,
         rrd: false,
+        resume: false,
         report: false,
         quiet: true,
     };
@@ -81,7 +82,7 @@ pub fn run_batch_bench(o: &BenchBatchArgs) -> anyhow::Result<BatchBenchRow> {
                 );
             }
             let t = Instant::now();
-            let done = batch::run_batch(&b, jobs, 1, None, false)?;
+            let done = batch::run_batch(&b, jobs, 1, None, false, (None, &Default::default()))?;
             times.push(t.elapsed().as_secs_f64());
             let mut summaries = Vec::new();
             for f in done {

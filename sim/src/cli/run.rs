@@ -4,7 +4,7 @@ use crate::RunExports;
 use crate::options::check_duration;
 use crate::report::data::RunReport;
 use crate::run::report::{OutputArgs, report_run};
-use crate::run::run_scenario_exporting;
+use crate::run::{OutputsFailed, run_scenario_exporting};
 use crate::scenario::scenario_arg;
 use std::path::PathBuf;
 
@@ -68,7 +68,7 @@ pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
         // the true paths of the report's map
         opts.trajectory_period = Some(REPORT_TRUTH_PERIOD_S);
     }
-    let out = run_scenario_exporting(
+    let run = run_scenario_exporting(
         &sc,
         &opts,
         &RunExports {
@@ -76,14 +76,23 @@ pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
             save_map: a.out.save_map.clone(),
             mcap: a.mcap.clone(),
         },
-    )?;
+    );
+    // an output that failed does not stop the others, nor the files written from the summary
+    let (out, failures) = OutputsFailed::split(run)?;
+    let mut report = a.out.report(rrd_path.as_deref(), a.log.as_deref());
+    if failures.recording {
+        report.rrd = None;
+    }
+    let mut written = report_run(&out, &report);
     if let Some(dir) = &a.report {
-        let page = crate::report::write_run(dir, &RunReport::of_run(&sc, &out)?)?;
-        if !a.out.quiet {
-            println!("report written to {}", page.display());
+        let page = RunReport::of_run(&sc, &out).and_then(|r| crate::report::write_run(dir, &r));
+        match page {
+            Ok(page) if !a.out.quiet => println!("report written to {}", page.display()),
+            Ok(_) => {}
+            Err(e) => written = written.and(Err(e)),
         }
     }
-    report_run(&out, &a.out.report(rrd_path.as_deref(), a.log.as_deref()))
+    failures.or(written)
 }
 
 /// Seconds between the true poses a report's map draws.

@@ -36,7 +36,7 @@ use crate::build::{BuildMode, Reusable, SimWorld, build_world_with};
 use crate::record::mcap::McapRecording;
 use crate::run::exports::RunExports;
 use crate::run::report::report_run;
-use crate::run::{RunOptions, RunOutput, run_built};
+use crate::run::{OutputsFailed, RunOptions, RunOutput, run_built};
 use crate::scenario::Scenario;
 use feed::FedRobot;
 use std::path::PathBuf;
@@ -149,8 +149,13 @@ pub fn replay_command(a: &ReplayArgs) -> anyhow::Result<()> {
         save_map: a.out.save_map.clone(),
         ..Default::default()
     };
-    let out = replay(plan, &a.out.run_options(rrd.clone()), &exports)?;
-    report_run(&out, &a.out.report(rrd.as_deref(), None))
+    let run = replay(plan, &a.out.run_options(rrd.clone()), &exports);
+    let (out, failures) = OutputsFailed::split(run)?;
+    let mut report = a.out.report(rrd.as_deref(), None);
+    if failures.recording {
+        report.rrd = None;
+    }
+    failures.or(report_run(&out, &report))
 }
 
 #[cfg(test)]

@@ -39,30 +39,43 @@ impl RunExports {
         self.carmen_out.is_some() || self.save_map.is_some() || self.mcap.is_some()
     }
 
-    /// Writes the exports of a finished run. Maps are judged against the scenario's map: SLAM
-    /// systems start at the robot's true start pose, so their map frame is the world frame.
+    /// Writes the exports of a finished run, each whatever became of the others: what was
+    /// written; a message naming the file for each export that failed is pushed to `errors`.
+    /// Maps are judged against the scenario's map: SLAM systems start at the robot's true
+    /// start pose, so their map frame is the world frame.
     pub(crate) fn finish(
         &self,
         world: &mut World,
         scenario: &Scenario,
-    ) -> anyhow::Result<Exported> {
+        errors: &mut Vec<String>,
+    ) -> Exported {
         let mut done = Exported::default();
         if let Some(export) = world.remove_resource::<CarmenExport>() {
-            done.carmen_logs = export.save()?;
+            match export.save() {
+                Ok(logs) => done.carmen_logs = logs,
+                Err(e) => errors.push(format!("{e:#}")),
+            }
         }
         if let Some(export) = world.remove_resource::<McapExport>() {
-            done.mcap = Some(export.finish()?);
+            match export.finish() {
+                Ok(m) => done.mcap = Some(m),
+                Err(e) => errors.push(format!("{e:#}")),
+            }
         }
         if let Some(path) = &self.save_map {
             let maps = run_maps(world);
             if maps.is_empty() {
-                anyhow::bail!(
+                errors.push(format!(
                     "--save-map: {} has no robot with a laser or a SLAM system to map with",
                     scenario.source
-                );
+                ));
+            } else {
+                match save_maps(path, &maps, Some((&scenario.grid, &Pose2::default()))) {
+                    Ok(m) => done.maps = m,
+                    Err(e) => errors.push(format!("{e:#}")),
+                }
             }
-            done.maps = save_maps(path, &maps, Some((&scenario.grid, &Pose2::default())))?;
         }
-        Ok(done)
+        done
     }
 }

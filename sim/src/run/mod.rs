@@ -37,7 +37,7 @@ pub use crate::formats::tum::RobotLocalization;
 pub use capture::ScanCapture;
 pub use command::{Command, SimError, Target};
 pub use controller::{Controller, Observation};
-pub use outputs::output_plugins;
+pub use outputs::{Failures, OutputsFailed, output_plugins};
 pub use simulation::{Finished, Simulation, SimulationBuilder};
 pub use view::{
     DoorView, Estimate, LocalizerView, NavigationView, PersonView, RobotView, ScanView, Twist,
@@ -77,7 +77,8 @@ pub struct RunOutput {
     pub interrupted: bool,
 }
 
-/// Runs a scenario to its end.
+/// Runs a scenario to its end. When some output cannot be written (the recording, an export),
+/// the others still are, and the error is an [`OutputsFailed`] holding the [`RunOutput`].
 pub fn run_scenario(scenario: &Scenario, opts: &RunOptions) -> anyhow::Result<RunOutput> {
     run(scenario, opts, None, &RunExports::default())
 }
@@ -187,8 +188,8 @@ fn run_world(
     if opts.trajectory_period.is_some() {
         trajectory.push((sim.time(), truth_poses(sim.world_mut())));
     }
-    let done = sim.finish()?;
-    Ok(RunOutput {
+    let (done, failures) = OutputsFailed::split(sim.finish())?;
+    let out = RunOutput {
         summary: done.summary,
         trajectory,
         localization: done.localization,
@@ -196,7 +197,8 @@ fn run_world(
         log: done.log,
         exported: done.exported,
         interrupted: stepped.interrupted,
-    })
+    };
+    OutputsFailed::check(out, failures)
 }
 
 /// How the stepping ended.

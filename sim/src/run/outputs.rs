@@ -84,20 +84,104 @@ pub(crate) fn finish_estimators_and_frames(w: &mut World) -> Option<String> {
     finish_frames(w)
 }
 
-/// Writes the end of the recording and the exports.
+/// Writes the end of the recording and the exports, each whatever became of the others: the
+/// files written, and the failures (whether the recording's among them).
 pub(crate) fn finish_files(
     w: &mut World,
     scenario: &Scenario,
     exports: &RunExports,
-) -> anyhow::Result<Exported> {
+) -> (Exported, Failures) {
+    let mut failures = Failures::default();
     if w.contains_resource::<RrdRecorder>() {
         record_slam_final(w);
     }
-    if let Some(mut rec) = w.remove_resource::<RrdRecorder>() {
-        rec.finish()?;
+    if let Some(mut rec) = w.remove_resource::<RrdRecorder>()
+        && let Err(e) = rec.finish()
+    {
+        failures.errors.push(format!("{e:#}"));
+        failures.recording = true;
     }
-    exports.finish(w, scenario)
+    let exported = exports.finish(w, scenario, &mut failures.errors);
+    (exported, failures)
 }
+
+/// The outputs of a run that could not be written (each error names its file).
+#[derive(Clone, Debug, Default)]
+pub struct Failures {
+    /// One message per output that failed.
+    pub errors: Vec<String>,
+    /// Whether the Rerun recording is among them.
+    pub recording: bool,
+}
+
+impl Failures {
+    /// `then` (what came after the outputs, e.g. writing the summary) when no output failed;
+    /// else an error listing the failures, and `then`'s error after them.
+    pub fn or(self, then: anyhow::Result<()>) -> anyhow::Result<()> {
+        if self.errors.is_empty() {
+            return then;
+        }
+        let mut lines = self.errors;
+        if let Err(e) = then {
+            lines.push(format!("{e:#}"));
+        }
+        Err(anyhow::anyhow!("{}", lines.join("\n")))
+    }
+}
+
+/// A run that went to its end but could not write some of its outputs: what it left anyway
+/// (`done`: the summary, the files that were written) and the failures. The error
+/// [`crate::Simulation::finish`] and the run functions return then; a command that writes more
+/// after the run (the summary, trajectories) takes `done` back with [`OutputsFailed::split`].
+pub struct OutputsFailed<T> {
+    /// What the run left.
+    pub done: Box<T>,
+    /// The outputs that failed.
+    pub failures: Failures,
+}
+
+impl<T: Send + Sync + 'static> OutputsFailed<T> {
+    /// The run's result and the outputs that failed (none for a success); other errors stay
+    /// errors.
+    pub fn split(r: anyhow::Result<T>) -> anyhow::Result<(T, Failures)> {
+        match r {
+            Ok(done) => Ok((done, Failures::default())),
+            Err(e) => {
+                let f = e.downcast::<OutputsFailed<T>>()?;
+                Ok((*f.done, f.failures))
+            }
+        }
+    }
+
+    /// `Ok(done)` when nothing failed, else this error.
+    pub fn check(done: T, failures: Failures) -> anyhow::Result<T> {
+        if failures.errors.is_empty() {
+            Ok(done)
+        } else {
+            Err(OutputsFailed {
+                done: Box::new(done),
+                failures,
+            }
+            .into())
+        }
+    }
+}
+
+impl<T> std::fmt::Display for OutputsFailed<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.failures.errors.join("\n"))
+    }
+}
+
+impl<T> std::fmt::Debug for OutputsFailed<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OutputsFailed")
+            .field("failures", &self.failures)
+            .finish_non_exhaustive()
+    }
+}
+
+impl<T> std::error::Error for OutputsFailed<T> {}
 
 /// The camera frames still being rendered go to the recordings; the worker's error, if any.
 fn finish_frames(w: &mut World) -> Option<String> {

@@ -96,7 +96,8 @@ pub struct RunReport<'a> {
 }
 
 /// Prints the summary table and what was written, writes the trajectories, the log and the
-/// summary asked for; an interrupted run is then an error (exit code 130).
+/// summary asked for (each whatever became of the others; the failures are then the error);
+/// an interrupted run is then an error (exit code 130).
 pub fn report_run(out: &RunOutput, r: &RunReport<'_>) -> anyhow::Result<()> {
     if !r.quiet {
         print!("{}", out.summary.table());
@@ -122,14 +123,17 @@ pub fn report_run(out: &RunOutput, r: &RunReport<'_>) -> anyhow::Result<()> {
             );
         }
     }
+    // each file is written whatever became of the others
+    let mut failed = Vec::new();
     if let Some(dir) = r.trajectories {
-        let files = write_trajectories(dir, &out.localization, r.estimates)?;
-        if !r.quiet {
-            println!(
+        match write_trajectories(dir, &out.localization, r.estimates) {
+            Ok(files) if !r.quiet => println!(
                 "{} trajectory files written to {}",
                 files.len(),
                 dir.display()
-            );
+            ),
+            Ok(_) => {}
+            Err(e) => failed.push(format!("{e:#}")),
         }
     }
     if let Some(p) = r.log {
@@ -138,11 +142,18 @@ pub fn report_run(out: &RunOutput, r: &RunReport<'_>) -> anyhow::Result<()> {
             let who = if robot.is_empty() { "-" } else { robot };
             text += &format!("{t:9.2} {who:<12} {what}\n");
         }
-        write_file(p, "log", text)?;
+        if let Err(e) = write_file(p, "log", text) {
+            failed.push(format!("{e:#}"));
+        }
     }
     if let Some(p) = r.summary {
         let json = serde_json::to_string_pretty(&out.summary)?;
-        write_file(p, "summary", json + "\n")?;
+        if let Err(e) = write_file(p, "summary", json + "\n") {
+            failed.push(format!("{e:#}"));
+        }
+    }
+    if !failed.is_empty() {
+        anyhow::bail!("{}", failed.join("\n"));
     }
     if out.interrupted {
         return Err(crate::run::interrupt::Interrupted {

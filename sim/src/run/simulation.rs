@@ -19,7 +19,7 @@ use super::attach::{attach_controllers, attach_estimators};
 use super::command::{SimError, names};
 use super::controller::{Controller, UserControllers};
 use super::exports::{Exported, RunExports};
-use super::outputs;
+use super::outputs::{self, OutputsFailed};
 use super::summary::{Summary, collect};
 use super::view::{DoorView, PersonView, RobotView};
 use crate::build::{BuildMode, Reusable, SimWorld, build_world_with};
@@ -482,14 +482,18 @@ impl Simulation {
     }
 
     /// Ends the run where it is: the estimators and recordings are finished, the files
-    /// written, and the summary read (covering the ticks run).
+    /// written, and the summary read (covering the ticks run). A file that cannot be written
+    /// does not stop the others; the error is then an [`OutputsFailed`] holding the
+    /// [`Finished`] run (taken back with [`OutputsFailed::split`]).
     pub fn finish(mut self) -> anyhow::Result<Finished> {
         let world = &mut self.sim.world;
         let frame_error = outputs::finish_estimators_and_frames(world);
         let wall_time_s = self.started.map_or(0.0, |s| s.elapsed().as_secs_f64());
-        let exported = outputs::finish_files(world, &self.scenario, &self.exports)?;
+        let (exported, mut failures) = outputs::finish_files(world, &self.scenario, &self.exports);
         if let Some(e) = frame_error {
-            anyhow::bail!("recording camera frames: {e}");
+            failures
+                .errors
+                .push(format!("recording camera frames: {e}"));
         }
         let sim_time_s = self.ticks as f64 * self.scenario.dt;
         let summary = Summary {
@@ -501,12 +505,13 @@ impl Simulation {
             robots: collect::robot_summaries(world),
             timing: collect::timing(world),
         };
-        Ok(Finished {
+        let done = Finished {
             summary,
             localization: collect::robot_localization(world),
             log: collect::event_log(world),
             exported,
-        })
+        };
+        OutputsFailed::check(done, failures)
     }
 
     /// The robot called `name`.

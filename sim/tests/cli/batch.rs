@@ -326,3 +326,160 @@ fn bad_arguments_give_clear_errors() {
         "{e}"
     );
 }
+
+/// The rows of `dir`'s runs.jsonl without their wall-clock fields, one string per row.
+fn rows_without_timing(dir: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(dir.join("runs.jsonl")).unwrap();
+    text.lines()
+        .map(|l| {
+            let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
+            let o = v.as_object_mut().unwrap();
+            for k in ["job_wall_s", "wall_time_s", "real_time_factor"] {
+                o.remove(k);
+            }
+            v.to_string()
+        })
+        .collect()
+}
+
+/// A shard killed mid-way keeps the rows of the runs it finished; batch-merge refuses the
+/// folder and says how to finish it; `--resume` runs only the missing jobs, and the merged
+/// batch equals the batch run whole, row for row (apart from wall-clock fields).
+#[test]
+fn a_killed_shard_resumes_and_merges_to_the_whole_batch() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = room();
+    let args = |shard: &'static str, out: &'static str| {
+        let mut a = vec![
+            "batch",
+            "tiny.toml",
+            "--seeds",
+            "0..40",
+            "--duration",
+            "200",
+        ];
+        a.extend(["--jobs", "1", "--out", out, "--quiet"]);
+        if !shard.is_empty() {
+            a.extend(["--shard", shard]);
+        }
+        a
+    };
+    run_ok(&args("0/2", "s0"), dir.path());
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_sim"))
+        .args(args("1/2", "s1"))
+        .current_dir(dir.path())
+        .spawn()
+        .unwrap();
+    let rows = dir.path().join("s1/runs.jsonl");
+    let started = std::time::Instant::now();
+    while std::fs::read_to_string(&rows).map_or(0, |t| t.lines().count()) < 3 {
+        assert!(started.elapsed().as_secs() < 120, "no rows appear");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(
+        status.signal(),
+        Some(9),
+        "the shard ended before it was killed"
+    );
+    let done_before = std::fs::read_to_string(&rows).unwrap().lines().count();
+    assert!((3..20).contains(&done_before), "{done_before} rows");
+    expect_failure(
+        &["batch-merge", "m", "s0", "s1"],
+        dir.path(),
+        &["s1/runs.jsonl", "incomplete", "--resume"],
+    );
+    let mut resume = args("1/2", "s1");
+    resume.retain(|a| *a != "--quiet");
+    resume.push("--resume");
+    let out = crate::common::sim(&resume, dir.path());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(&format!(
+            "resuming: {done_before} of 20 runs are done, {} to run",
+            20 - done_before
+        )),
+        "{err}"
+    );
+    run_ok(&["batch-merge", "m", "s0", "s1", "--quiet"], dir.path());
+    run_ok(&args("", "whole"), dir.path());
+    let (merged, whole) = (
+        rows_without_timing(&dir.path().join("m")),
+        rows_without_timing(&dir.path().join("whole")),
+    );
+    assert_eq!(merged.len(), 40);
+    assert_eq!(merged, whole);
+}
+
+/// A batch whose runs partly fail (a parameter value the scenario refuses) reports them, exits
+/// with 2, and `--resume` runs only those again; a folder of another batch is not resumed.
+#[test]
+fn resume_runs_only_the_failed_runs_and_refuses_another_batch() {
+    let dir = room();
+    let args = |extra: &[&'static str]| {
+        let mut a = vec!["batch", "tiny.toml", "--seeds", "0..2", "--duration", "1"];
+        a.extend([
+            "--sweep",
+            "robots.0.behaviour.speed=0.5,-1,0.7",
+            "--jobs",
+            "1",
+        ]);
+        a.extend(["--out", "o"]);
+        a.extend_from_slice(extra);
+        a
+    };
+    let out = crate::common::sim(&args(&["--quiet"]), dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("set 1 (robots.0.behaviour.speed=-1) does not load"),
+        "{err}"
+    );
+    let ok_lines = || {
+        let text = std::fs::read_to_string(dir.path().join("o/runs.jsonl")).unwrap();
+        let ok: Vec<String> = text
+            .lines()
+            .filter(|l| l.contains("\"status\":\"ok\""))
+            .map(String::from)
+            .collect();
+        ok
+    };
+    let (first, first_ok) = (rows_without_timing(&dir.path().join("o")), ok_lines());
+    assert_eq!(first.len(), 6);
+    let out = crate::common::sim(&args(&["--resume"]), dir.path());
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("resuming: 4 of 6 runs are done, 2 to run"),
+        "{err}"
+    );
+    assert!(err.contains("2 of 6 runs failed"), "{err}");
+    assert_eq!(rows_without_timing(&dir.path().join("o")), first);
+    // the successful runs were not run again: their rows are kept, wall times included
+    assert_eq!(ok_lines(), first_ok);
+    let mut other = args(&["--resume"]);
+    other[5] = "2";
+    expect_failure(
+        &other,
+        dir.path(),
+        &[
+            "--resume",
+            "holds another batch: --duration is 1 there, 2 here",
+        ],
+    );
+    expect_failure(
+        &[
+            "batch",
+            "tiny.toml",
+            "--seeds",
+            "0..2",
+            "--out",
+            "new",
+            "--resume",
+        ],
+        dir.path(),
+        &["new holds no batch"],
+    );
+}

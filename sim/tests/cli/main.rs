@@ -7,6 +7,7 @@ mod bench;
 mod carmen;
 mod common;
 mod experiment;
+mod faults;
 mod interrupt;
 mod matching;
 mod replay;

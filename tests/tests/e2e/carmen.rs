@@ -271,11 +271,10 @@ fn a_pose_graph_is_recorded_with_its_edges_and_nodes() {
     };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("g.rrd");
-    let rec = sim::record::rrd::open_recording(&path, "graph").unwrap();
-    let mut rec = sim::record::rrd::stream::RrdStream::new(rec);
+    let mut rec = sim::record::rrd::open_recording(&path, "graph").unwrap();
     rec.set_duration_secs("sim_time", 1.0);
     log_slam_state(&mut rec, &slam_entity("r", "square", 1), &SquareGraph).unwrap();
-    rec.flush_blocking().unwrap();
+    rec.close().unwrap();
     drop(rec);
     let paths = entity_paths(&check_rrd_with(&rerun, &path));
     for leaf in ["map", "trajectory", "graph", "graph/nodes"] {

@@ -40,7 +40,7 @@ impl ReplayRecorder {
         (t0, slam_rate): (f64, f64),
     ) -> anyhow::Result<Self> {
         Ok(ReplayRecorder {
-            rec: RrdStream::new(open_recording(path, robot)?),
+            rec: open_recording(path, robot)?,
             robot: robot.to_string(),
             base: slam_entity(robot, slam, 1),
             t0,

@@ -127,9 +127,8 @@ impl RrdRecorder {
         grid: &OccupancyGrid,
         config: &RecordConfig,
     ) -> anyhow::Result<Self> {
-        let rec = open_recording(path, scenario_name)?;
         let mut r = RrdRecorder {
-            rec: RrdStream::new(rec),
+            rec: open_recording(path, scenario_name)?,
             pose_timer: RateTimer::new(config.rate, 0.0),
             scan_timer: RateTimer::new(config.scan_rate, 0.0),
             path_timer: RateTimer::new(config.path_rate, 0.0),
@@ -223,12 +222,13 @@ fn known_bounds(grid: &OccupancyGrid) -> Option<[f64; 4]> {
     })
 }
 
-/// Flushes a recording to disk; returns `error` (the first logging error seen) or the flush's.
+/// Ends a recording: everything flushed to the file, the footer written; returns `error` (the
+/// first logging error seen) or the file's, naming the file.
 pub(super) fn close_recording(rec: &mut RrdStream, error: Option<String>) -> anyhow::Result<()> {
-    let flushed = rec.flush_blocking();
-    match error.or(flushed.err()) {
-        Some(e) => Err(anyhow::anyhow!("writing the recording failed: {e}")),
-        None => Ok(()),
+    let closed = rec.close();
+    match error.map_or(closed, Err) {
+        Err(e) => Err(anyhow::anyhow!("{e}")),
+        Ok(()) => Ok(()),
     }
 }
 
@@ -256,7 +256,7 @@ fn scan_points<'a>(
 }
 
 /// Opens an .rrd file for writing, z up (the floor plan seen from above).
-pub fn open_recording(path: &Path, name: &str) -> anyhow::Result<rerun::RecordingStream> {
+pub fn open_recording(path: &Path, name: &str) -> anyhow::Result<RrdStream> {
     // Chunks are cut by size, not by wall time (the default flushes every 200 ms of wall
     // time, which gives a fast run thousands of tiny chunks of mostly metadata): a quarter
     // of the file size for a run with localizers, and the same chunks whatever the speed.
@@ -265,17 +265,18 @@ pub fn open_recording(path: &Path, name: &str) -> anyhow::Result<rerun::Recordin
         flush_num_bytes: 1024 * 1024,
         ..rerun::log::ChunkBatcherConfig::DEFAULT
     };
-    // the SDK starts its batcher and file-writer threads here: at background priority
+    let (sink, file) = stream::file_sink::create(path)?;
+    // the SDK starts its batcher and forwarding threads here: at background priority
     let rec = crate::record::priority::in_background(|| {
         rerun::RecordingStreamBuilder::new("sim")
             .recording_name(name)
             .batcher_config(batcher)
-            .save(path)
+            .set_sinks(vec![Box::new(sink) as Box<dyn rerun::sink::LogSink>])
     })
     .map_err(|e| anyhow::anyhow!("{}: cannot create the recording: {e}", path.display()))?;
     rec.log_static("/", &rerun::ViewCoordinates::RIGHT_HAND_Z_UP())
         .map_err(|e| anyhow::anyhow!("{}: cannot write the recording: {e}", path.display()))?;
-    Ok(rec)
+    Ok(RrdStream::writing_to(rec, file))
 }
 
 /// A GridMap of one byte per cell (row 0 at the origin corner, as ROS and GridMap expect).

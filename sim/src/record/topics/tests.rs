@@ -72,7 +72,9 @@ fn run_live(name: &str, duration: f64, path: &Path) -> (Live, McapWritten) {
             }
         }
     }
-    let done = exports.finish(&mut sim.world, &sc).unwrap();
+    let mut errors = Vec::new();
+    let done = exports.finish(&mut sim.world, &sc, &mut errors);
+    assert_eq!(errors, Vec::<String>::new());
     (live, done.mcap.unwrap())
 }
 
@@ -221,7 +223,10 @@ fn a_write_error_during_the_run_is_reported_at_the_end() {
             for _ in 0..(sc.duration / sc.dt).round() as usize {
                 sim.step();
             }
-            exports.finish(&mut sim.world, &sc).unwrap_err().to_string()
+            let mut errors = Vec::new();
+            let done = exports.finish(&mut sim.world, &sc, &mut errors);
+            assert!(done.mcap.is_none());
+            errors.join("\n")
         }
     };
     assert!(e.starts_with("/dev/full: cannot"), "{e}");

@@ -29,6 +29,7 @@ use std::sync::mpsc;
 use std::thread::JoinHandle;
 
 mod columns;
+pub mod file_sink;
 
 pub use columns::Row;
 use columns::{Columns, Serialized};
@@ -67,6 +68,8 @@ pub struct RrdStream {
     out: usize,
     /// Entities logged as static data, in the order of their first row.
     statics: Vec<String>,
+    /// The file the SDK writes to, finished by [`RrdStream::close`] (None: another sink).
+    file: Option<file_sink::RrdFile>,
 }
 
 impl RrdStream {
@@ -103,6 +106,15 @@ impl RrdStream {
             spare: Vec::new(),
             out: 0,
             statics: Vec::new(),
+            file: None,
+        }
+    }
+
+    /// A stream whose recording writes to `file` (see [`file_sink::create`]).
+    pub fn writing_to(rec: RecordingStream, file: file_sink::RrdFile) -> Self {
+        RrdStream {
+            file: Some(file),
+            ..RrdStream::new(rec)
         }
     }
 
@@ -286,6 +298,21 @@ impl RrdStream {
             first.get_or_insert_with(|| e.to_string());
         }
         first.map_or(Ok(()), Err)
+    }
+
+    /// [`RrdStream::flush_blocking`], then the file's footer is written and the file closed;
+    /// the first error, naming the file.
+    pub fn close(&mut self) -> Result<(), String> {
+        let flushed = self.flush_blocking();
+        let Some(file) = self.file.take() else {
+            return flushed;
+        };
+        flushed.and(file.finish()).map_err(|e| {
+            format!(
+                "{}: writing the recording failed: {e}",
+                file.path().display()
+            )
+        })
     }
 }
 
