@@ -143,15 +143,13 @@ pub fn is_covariance(c: &[[f64; 3]; 3]) -> bool {
         .map(|i| c[i][i].abs())
         .fold(f64::MIN_POSITIVE, f64::max);
     let eps = 1e-9 * scale;
-    for i in 0..3 {
-        if c[i][i] < -eps {
-            return false;
-        }
-        for j in 0..3 {
-            if (c[i][j] - c[j][i]).abs() > eps {
-                return false;
-            }
-        }
+    let pairs = (0..3).flat_map(|i| (0..3).map(move |j| (i, j)));
+    if (0..3).any(|i| c[i][i] < -eps)
+        || pairs
+            .into_iter()
+            .any(|(i, j)| (c[i][j] - c[j][i]).abs() > eps)
+    {
+        return false;
     }
     let minor = |i: usize, j: usize| c[i][i] * c[j][j] - c[i][j] * c[j][i];
     let det = c[0][0] * minor(1, 2) - c[0][1] * (c[1][0] * c[2][2] - c[1][2] * c[2][0])
