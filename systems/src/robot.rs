@@ -67,4 +67,6 @@ impl RobotBundle {
 }
 
 #[cfg(test)]
+mod faults;
+#[cfg(test)]
 mod tests;

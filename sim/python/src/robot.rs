@@ -524,8 +524,8 @@ pub struct PyEstimate {
     covariance: Option<Py<PyAny>>,
     /// When its estimates came and stayed close to the truth (s), None if not (yet).
     converged_after: Option<f64>,
-    /// True while the robot's laser is faulted: the estimate is the last one carried forward
-    /// by the odometry, its covariance growing with the path.
+    /// True while the robot's laser is faulted or its scans have no usable beam: the estimate
+    /// is the last one carried forward by the odometry, its covariance growing with the path.
     degraded: bool,
 }
 

@@ -255,8 +255,9 @@ pub struct LocalizerView<'w> {
     pub kind: &'static str,
     /// The latest estimate (None before its first).
     pub estimate: Option<Estimate>,
-    /// The robot's laser is faulted: the estimate is the last one carried forward by the
-    /// odometry, its covariance growing with the path, until the laser works again.
+    /// The robot's laser is faulted, or its scans have no usable beam: the estimate is the last
+    /// one carried forward by the odometry, its covariance growing with the path, until a scan
+    /// with returns comes.
     pub degraded: bool,
     /// When its estimates came and stayed close to the truth (the summary's convergence,
     /// judged on the estimates so far: known once they have stayed close for the summary's

@@ -56,6 +56,12 @@ impl DriveCommand {
     pub const fn new(v: f64, w: f64) -> DriveCommand {
         DriveCommand { v, w, steer: None }
     }
+
+    /// Whether a drive can act on it: no NaN in it (infinite speeds are fine: the drive's
+    /// limits make them its fastest).
+    pub fn is_usable(&self) -> bool {
+        !(self.v.is_nan() || self.w.is_nan() || self.steer.is_some_and(f64::is_nan))
+    }
 }
 
 /// Actuator state, advanced by the physics step.
@@ -80,12 +86,38 @@ impl DiffDrive {
         let half = self.wheel_base / 2.0;
         let l = (cmd.v - cmd.w * half) / self.wheel_radius;
         let r = (cmd.v + cmd.w * half) / self.wheel_radius;
+        if !(l.is_finite() && r.is_finite()) {
+            return self.saturated_targets(cmd);
+        }
         let m = l.abs().max(r.abs());
         if m > self.max_wheel_speed && m > 0.0 {
             let s = self.max_wheel_speed / m;
             (l * s, r * s)
         } else {
             (l, r)
+        }
+    }
+
+    /// [`DiffDrive::wheel_targets`] of a command whose wheel speeds overflow (huge or infinite
+    /// v or ω): the command's curvature at the speed limit, computed on the command scaled
+    /// into range first (inf · 0 made them NaN); a NaN command stops the wheels.
+    fn saturated_targets(&self, cmd: &DriveCommand) -> (f64, f64) {
+        let (v, w) = (
+            cmd.v.clamp(-f64::MAX, f64::MAX),
+            cmd.w.clamp(-f64::MAX, f64::MAX),
+        );
+        let scale = v.abs().max(w.abs());
+        if scale.is_nan() || scale == 0.0 {
+            return (0.0, 0.0);
+        }
+        let half = self.wheel_base / 2.0;
+        let l = (v / scale - w / scale * half) / self.wheel_radius;
+        let r = (v / scale + w / scale * half) / self.wheel_radius;
+        let m = l.abs().max(r.abs());
+        if m > 0.0 && m.is_finite() {
+            (l / m * self.max_wheel_speed, r / m * self.max_wheel_speed)
+        } else {
+            (0.0, 0.0)
         }
     }
 
@@ -103,11 +135,9 @@ impl Ackermann {
         if v.abs() < 1e-6 {
             return None;
         }
-        Some(
-            (w * self.wheelbase / v)
-                .atan()
-                .clamp(-self.max_steer, self.max_steer),
-        )
+        // ∞/∞ (both infinite) has no angle: the wheels stay where they are
+        let steer = (w * self.wheelbase / v).atan();
+        (!steer.is_nan()).then(|| steer.clamp(-self.max_steer, self.max_steer))
     }
 
     pub fn yaw_rate(&self, speed: f64, steer: f64) -> f64 {
@@ -127,8 +157,11 @@ impl Ackermann {
 
 impl Kinematics {
     /// Advances the actuator state towards the command over `dt` under the limits and returns the
-    /// body twist (v, ω) driven during the step.
+    /// body twist (v, ω) driven during the step. A command with a NaN in it (a broken driver)
+    /// counts as a stop: it never reaches the actuators.
     pub fn step(&self, cmd: &DriveCommand, state: &mut DriveState, dt: f64) -> (f64, f64) {
+        const STOP: DriveCommand = DriveCommand::new(0.0, 0.0);
+        let cmd = if cmd.is_usable() { cmd } else { &STOP };
         match self {
             Kinematics::DiffDrive(d) => {
                 let (tl, tr) = d.wheel_targets(cmd);
@@ -303,5 +336,115 @@ mod tests {
             d.step(&with_steer, &mut a, 0.1),
             d.step(&DriveCommand::new(0.5, 0.2), &mut b, 0.1)
         );
+    }
+
+    fn diff() -> DiffDrive {
+        DiffDrive {
+            wheel_base: 0.5,
+            wheel_radius: 0.1,
+            max_wheel_speed: 20.0,
+            max_wheel_accel: 40.0,
+        }
+    }
+
+    fn car() -> Ackermann {
+        Ackermann {
+            wheelbase: 0.35,
+            max_steer: 0.5,
+            max_steer_rate: 2.0,
+            max_speed: 3.0,
+            max_accel: 2.0,
+            wheel_radius: 0.05,
+        }
+    }
+
+    /// Regression: an infinite or overflowing speed made the wheel targets inf · 0 = NaN; they
+    /// are the fastest the wheels turn, in the command's direction.
+    #[test]
+    fn an_infinite_command_is_the_fastest_the_wheels_turn() {
+        let d = diff();
+        assert_eq!(
+            d.wheel_targets(&DriveCommand::new(f64::INFINITY, 0.0)),
+            (20.0, 20.0)
+        );
+        assert_eq!(
+            d.wheel_targets(&DriveCommand::new(-1e308, 0.0)),
+            (-20.0, -20.0)
+        );
+        let (l, r) = d.wheel_targets(&DriveCommand::new(0.0, f64::NEG_INFINITY));
+        assert_eq!((l, r), (20.0, -20.0));
+        // ordinary commands are computed as before
+        assert_eq!(d.wheel_targets(&DriveCommand::new(1.0, 0.0)), (10.0, 10.0));
+    }
+
+    /// Regression: a NaN command (v, ω or a car's steering angle) reached the wheel speeds and
+    /// from there the pose; it counts as a stop.
+    #[test]
+    fn a_nan_command_stops_the_robot() {
+        for kin in [Kinematics::DiffDrive(diff()), Kinematics::Ackermann(car())] {
+            let mut state = DriveState::default();
+            kin.step(&DriveCommand::new(1.0, 0.5), &mut state, 0.1);
+            for cmd in [
+                DriveCommand::new(f64::NAN, 0.0),
+                DriveCommand::new(0.0, f64::NAN),
+                DriveCommand {
+                    steer: Some(f64::NAN),
+                    ..DriveCommand::new(1.0, 0.0)
+                },
+            ] {
+                let (v, w) = kin.step(&cmd, &mut state, 0.1);
+                assert!(v.is_finite() && w.is_finite(), "{kin:?} {cmd:?}");
+            }
+            for _ in 0..100 {
+                kin.step(&DriveCommand::new(f64::NAN, f64::NAN), &mut state, 0.1);
+            }
+            let (v, _) = kin.step(&DriveCommand::new(f64::NAN, 0.0), &mut state, 0.1);
+            assert_eq!(v, 0.0, "{kin:?}");
+        }
+        // a car told to go infinitely fast while turning infinitely fast keeps its wheels
+        assert_eq!(car().steer_for(f64::INFINITY, f64::INFINITY), None);
+    }
+
+    mod props {
+        use super::*;
+        use crate::core::props::{config, extreme_f64};
+        use proptest::prelude::*;
+
+        proptest! {
+            #![proptest_config(config(512))]
+
+            /// Any sequence of commands (NaN, ±∞, huge) and steps (dt 0 included) leaves the
+            /// actuator state, the twist and the pose finite, within the drive's limits.
+            #[test]
+            fn any_command_drives_finite_within_the_limits(
+                ackermann in any::<bool>(),
+                cmds in proptest::collection::vec(
+                    (extreme_f64(), extreme_f64(), proptest::option::of(extreme_f64()),
+                     prop_oneof![Just(0.0f64), Just(0.05), 0.0f64..1.0]),
+                    1..20),
+            ) {
+                let kin = if ackermann {
+                    Kinematics::Ackermann(car())
+                } else {
+                    Kinematics::DiffDrive(diff())
+                };
+                let mut state = DriveState::default();
+                let mut pose = Pose2::new(1.0, 2.0, 0.3);
+                for (v, w, steer, dt) in cmds {
+                    let cmd = DriveCommand { v, w, steer };
+                    let (tv, tw) = kin.step(&cmd, &mut state, dt);
+                    prop_assert!(tv.is_finite() && tw.is_finite(), "{cmd:?}: ({tv}, {tw})");
+                    prop_assert!(tv.abs() <= kin.max_speed() + 1e-9);
+                    let s = [state.left, state.right, state.speed, state.steer];
+                    prop_assert!(s.iter().all(|x| x.is_finite()), "{state:?}");
+                    let before = pose;
+                    pose = integrate_arc(&pose, tv, tw, dt);
+                    prop_assert!(pose.x.is_finite() && pose.y.is_finite() && pose.theta.is_finite());
+                    if dt == 0.0 {
+                        prop_assert_eq!(pose, before);
+                    }
+                }
+            }
+        }
     }
 }

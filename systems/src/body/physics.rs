@@ -326,11 +326,15 @@ pub fn physics_step(
     )>,
     mut people: Query<(&PhysicsBody, &Walker, &mut TruePose), Without<Kinematics>>,
 ) {
+    let dt = clock.dt;
+    if dt.is_nan() || dt <= 0.0 {
+        // a step of no length moves nothing (and the velocities below divide by it)
+        return;
+    }
     let dirty = world.take_dirty_tiles();
     for (tx, ty) in dirty {
         physics.rebuild_tile(&world, tx, ty);
     }
-    let dt = clock.dt;
     let mut jobs = memory.take();
     jobs.extend(
         robots

@@ -57,6 +57,9 @@ impl RateTimer {
     /// skipped, so a timer created mid-run does not fire a burst).
     pub fn due(&mut self, start: f64, end: f64, out: &mut Vec<f64>) {
         out.clear();
+        if end.is_nan() {
+            return; // no time compares with it: the loop below would never end
+        }
         loop {
             let t = self.offset + self.next_index as f64 * self.period;
             if t > end + 1e-9 {
@@ -73,6 +76,18 @@ impl RateTimer {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression: a tick ending at NaN (a clock with a NaN step) made the timer loop for
+    /// ever; it fires nothing.
+    #[test]
+    fn a_timer_fires_nothing_in_a_tick_ending_at_nan() {
+        let mut timer = RateTimer::new(10.0, 0.0);
+        let mut out = vec![1.0];
+        timer.due(f64::NAN, f64::NAN, &mut out);
+        assert!(out.is_empty());
+        timer.due(0.0, 0.25, &mut out);
+        assert_eq!(out, [0.0, 0.1, 0.2]);
+    }
 
     #[test]
     fn timer_rate_is_independent_of_dt() {

@@ -11,6 +11,8 @@ pub mod moments;
 pub mod normal;
 pub mod pool;
 pub mod pose;
+#[cfg(test)]
+pub mod props;
 pub mod rng;
 pub mod schedule;
 pub mod source;

@@ -295,4 +295,101 @@ mod tests {
         assert!(t.converged && t.population.len() == f.config.min_population);
         assert!(t.evaluations < 2_000_000, "{}", t.evaluations);
     }
+
+    /// Properties under sensor faults: the range costs of any scan from any pose are finite and
+    /// non-negative, and the filter's estimate finite with a covariance.
+    mod props {
+        use super::*;
+        use crate::core::props::{config, extreme_f64, laser_fault, range_reading};
+        use crate::localization::de_population::range_costs;
+        use crate::localization::props::{estimate_fault, room, room_scan};
+        use crate::sensors::LaserScan;
+        use proptest::prelude::*;
+
+        fn small() -> DeFilterConfig {
+            DeFilterConfig {
+                population: 60,
+                min_population: 20,
+                generations: 3,
+                tracking_generations: 1,
+                refine_rounds: 2,
+                refine_samples: 8,
+                update_min_d: 0.0,
+                update_min_a: 0.0,
+                init: InitialBelief::Gaussian {
+                    pose: Pose2::new(6.0, 4.0, 0.3),
+                    sd: [0.3, 0.3, 0.1],
+                },
+                ..DeFilterConfig::default()
+            }
+        }
+
+        proptest! {
+            #![proptest_config(config(48))]
+
+            #[test]
+            fn range_costs_of_any_scan_from_any_pose_are_finite(
+                ranges in proptest::collection::vec(range_reading(10.0), 1..60),
+                poses in proptest::collection::vec(
+                    (extreme_f64(), extreme_f64(), extreme_f64()), 1..20),
+                l2 in any::<bool>(),
+            ) {
+                let map = room();
+                let n = ranges.len().max(2);
+                let scan = LaserScan {
+                    stamp: 0.0,
+                    angle_min: -2.0,
+                    angle_increment: 4.0 / (n - 1) as f32,
+                    range_min: 0.1,
+                    range_max: 10.0,
+                    ranges,
+                };
+                let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60);
+                let poses: Vec<[f64; 3]> = poses.iter().map(|p| [p.0, p.1, p.2]).collect();
+                let mut costs = vec![f64::NAN; poses.len()];
+                let metric = if l2 { RangeMetric::L2 } else { RangeMetric::L1 };
+                range_costs(&map, &beams, metric, &poses, &mut costs);
+                prop_assert!(costs.iter().all(|c| c.is_finite() && *c >= 0.0), "{costs:?}");
+            }
+
+            #[test]
+            fn the_filter_stays_finite_under_laser_faults_and_odometry_jumps(
+                steps in proptest::collection::vec(
+                    (proptest::option::of(laser_fault(10.0, 40)),
+                     prop_oneof![
+                         4 => (-0.3f64..0.3, -0.1f64..0.1, -0.3f64..0.3),
+                         1 => Just((0.0, 0.0, 0.0)),
+                         1 => (-1e6f64..1e6, -1e6f64..1e6, -1e3f64..1e3),
+                     ]),
+                    1..8),
+            ) {
+                let map = room();
+                let mut f = DeFilter::new(small(), &map, stream_rng(3, "props", "de"));
+                let mut truth = Pose2::new(6.0, 4.0, 0.3);
+                let mut odom = Pose2::IDENTITY;
+                let mut last: Option<Vec<f32>> = None;
+                for (fault, (dx, dy, dth)) in steps {
+                    let step = Pose2::new(dx, dy, dth);
+                    odom = odom.compose(&step);
+                    if dx.abs() < 1.0 {
+                        truth = truth.compose(&step);
+                    }
+                    let mut scan = room_scan(&map, &truth, 90);
+                    if let Some(fault) = &fault {
+                        fault.apply(&mut scan.ranges, 10.0, last.as_deref());
+                    }
+                    last = Some(scan.ranges.clone());
+                    let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 30);
+                    f.update(&map, &beams, &odom);
+                    let pop = &f.tracker.population;
+                    // +∞ marks a member not scored yet (no usable scan so far)
+                    prop_assert!(pop.costs.iter().all(|c| !c.is_nan() && *c >= 0.0));
+                    prop_assert!(pop.poses.iter().flatten().all(|v| v.is_finite()));
+                    if let Some(e) = f.estimate() {
+                        prop_assert_eq!(estimate_fault(&e), None);
+                    }
+                }
+            }
+        }
+    }
 }

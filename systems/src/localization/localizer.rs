@@ -72,8 +72,8 @@ impl Filter {
 pub struct StampedEstimate {
     pub stamp: f64,
     pub estimate: PoseEstimate,
-    /// Carried forward by the odometry alone while the laser is faulted (see
-    /// [`Localizer::degraded`]), not the filter's own.
+    /// Carried forward by the odometry alone while the laser is faulted or its scans have no
+    /// usable beam (see [`Localizer::degraded`]), not the filter's own.
     pub degraded: bool,
 }
 
@@ -139,9 +139,11 @@ pub struct Localizer {
     /// Wall-clock cost of its updates: a measurement of the machine, not of the run, so it is
     /// kept out of everything determinism covers.
     pub cost: UpdateCost,
-    /// True while the robot's laser is faulted: a map localizer then cannot correct, so it
-    /// publishes its last estimate carried forward by the odometry, with a covariance that
-    /// grows with the path, until the laser works again and the filter resumes.
+    /// True while the robot's laser is faulted, or its scans have no usable beam (every one
+    /// NaN, zero, below the minimum or at the maximum range): a map localizer then cannot
+    /// correct, so it publishes its last estimate carried forward by the odometry, with a
+    /// covariance that grows with the path, until a scan with returns comes and the filter
+    /// resumes.
     pub degraded: bool,
     anchor: Option<Anchor>,
 }
@@ -224,6 +226,13 @@ impl Localizer {
             return false;
         };
         let beams = scan.beams(f.max_beams());
+        if !beams.has_returns() {
+            // no usable beam (a laser sending NaN, zeros or nothing but its maximum range):
+            // degraded as while the laser is faulted, rather than a confident estimate the
+            // scan never confirmed
+            self.dead_reckon(scan_stamp, *odom);
+            return true;
+        }
         self.degraded = false;
         if f.predict(odom)
             && f.correct(map, beams)
@@ -414,4 +423,89 @@ pub fn run_localizers(
         })
         .collect();
     feed_robots(Some(&map), &pool, &mut feeds, |f| !f.is_scan());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+    use crate::localization::Mcl;
+    use crate::localization::mcl::{InitialBelief, MclConfig};
+    use crate::localization::odometry::OdometryModel;
+    use crate::localization::props::{estimate_fault, room, room_scan};
+    use crate::sensors::LaserScan;
+
+    /// A scan with no usable beam (all NaN, zero, negative, below the minimum or at the
+    /// maximum range) leaves a map localizer degraded, publishing its last estimate carried by
+    /// the odometry, as a faulted laser does; the next scan with returns ends it.
+    #[test]
+    fn scans_without_a_usable_beam_leave_the_localizer_degraded() {
+        let map = room();
+        let start = Pose2::new(6.0, 4.0, 0.3);
+        let config = MclConfig {
+            min_particles: 100,
+            max_particles: 300,
+            injection_candidates: 0,
+            challenge_every: 0,
+            update_min_d: 0.0,
+            update_min_a: 0.0,
+            init: InitialBelief::Gaussian {
+                pose: start,
+                sd: [0.2, 0.2, 0.1],
+            },
+            ..MclConfig::default()
+        };
+        let mcl = Mcl::new(config, &map, stream_rng(1, "test", "mcl"));
+        let mut locs = Localizers {
+            items: vec![Localizer::new("mcl", Filter::Map(Box::new(mcl)))],
+        };
+        let pool = KernelPool::new(1).unwrap();
+        let model = OdometryModel::DiffDrive {
+            left_radius: 0.1,
+            right_radius: 0.1,
+            wheel_base: 0.5,
+        };
+        let odom = WheelOdometry::new(model, 4096, Pose2::IDENTITY);
+        let mut scans = LaserScans::default();
+        let good = room_scan(&map, &start, 90);
+        let mut feed = |locs: &mut Localizers, scan: LaserScan| {
+            scans.scans = vec![scan];
+            locs.feed(Some(&map), &pool, &scans, Pose2::IDENTITY, &odom, |f| {
+                !f.is_scan()
+            });
+        };
+        feed(&mut locs, good.clone());
+        let l = &locs.items[0];
+        assert!(!l.degraded && l.latest.is_some_and(|e| !e.degraded));
+        for (k, fill) in [
+            f32::NAN,
+            0.0,
+            -1.0,
+            0.05,
+            10.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let mut bad = good.clone();
+            bad.ranges.fill(fill);
+            bad.stamp = 0.1 * (k + 1) as f64;
+            feed(&mut locs, bad);
+            let l = &locs.items[0];
+            assert!(l.degraded, "{fill}");
+            let e = l.latest.expect("the last estimate, carried");
+            assert!(
+                e.degraded && e.stamp == 0.1 * (k + 1) as f64,
+                "{fill}: {e:?}"
+            );
+            assert_eq!(estimate_fault(&e.estimate), None);
+        }
+        let mut back = good.clone();
+        back.stamp = 1.0;
+        feed(&mut locs, back);
+        let l = &locs.items[0];
+        assert!(!l.degraded && l.latest.is_some_and(|e| !e.degraded && e.stamp == 1.0));
+    }
 }

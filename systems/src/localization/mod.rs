@@ -22,6 +22,8 @@ pub mod road_wiring;
 pub mod scan_estimator;
 
 #[cfg(test)]
+pub(crate) mod props;
+#[cfg(test)]
 pub(crate) mod test_drive;
 
 pub use localizer::{Filter, Localizer, Localizers, StampedEstimate, UpdateCost};

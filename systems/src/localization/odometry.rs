@@ -53,8 +53,9 @@ impl WheelOdometry {
             return;
         };
         let k = TAU / self.ticks_per_rev as f64;
-        let dl = (left_ticks - l0) as f64 * k;
-        let dr = (right_ticks - r0) as f64 * k;
+        // counters wrap like the hardware's (a jump across the end of the range overflowed)
+        let dl = left_ticks.wrapping_sub(l0) as f64 * k;
+        let dr = right_ticks.wrapping_sub(r0) as f64 * k;
         let (ds, dth) = match self.model {
             OdometryModel::DiffDrive {
                 left_radius,
@@ -70,6 +71,8 @@ impl WheelOdometry {
                 wheelbase,
             } => {
                 let s = dl * wheel_radius;
+                // a steering reading that is no angle (NaN, ±∞) turns nothing
+                let steer = if steer.is_finite() { steer } else { 0.0 };
                 (s, s * steer.tan() / wheelbase)
             }
         };
@@ -199,5 +202,103 @@ mod tests {
         // after the last reading: extrapolated, at most one interval ahead
         assert!((o.pose_at(0.05).x - 2.5 * step).abs() < 1e-9);
         assert!((o.pose_at(9.0).x - 3.0 * step).abs() < 1e-9);
+    }
+
+    /// Regression: a counter jumping across the end of its range overflowed the tick
+    /// difference (a panic where overflow is checked); a NaN steering reading made the pose NaN.
+    #[test]
+    fn a_wrapping_counter_and_a_nan_steering_angle_leave_the_pose_finite() {
+        let mut o = WheelOdometry::new(
+            OdometryModel::DiffDrive {
+                left_radius: 0.1,
+                right_radius: 0.1,
+                wheel_base: 0.5,
+            },
+            1000,
+            Pose2::IDENTITY,
+        );
+        o.update(i64::MAX - 10, i64::MAX - 10, 0.0, 0.0);
+        // ten ticks on, past the end of the range
+        o.update(i64::MIN, i64::MIN + 2, 0.0, 0.02);
+        assert!(
+            (o.pose.x - 10.0 * TAU / 1000.0 * 0.1).abs() < 1e-3,
+            "{:?}",
+            o.pose
+        );
+        let mut car = WheelOdometry::new(
+            OdometryModel::Ackermann {
+                wheel_radius: 0.05,
+                wheelbase: 0.35,
+            },
+            1000,
+            Pose2::IDENTITY,
+        );
+        car.update(0, 0, 0.0, 0.0);
+        car.update(100, 100, f64::NAN, 0.02);
+        car.update(200, 200, f64::INFINITY, 0.04);
+        assert!(car.pose.x > 0.0 && car.pose.theta == 0.0, "{:?}", car.pose);
+    }
+
+    mod props {
+        use super::*;
+        use crate::core::props::{config, extreme_f64};
+        use proptest::prelude::*;
+
+        /// Encoder readings as a faulty encoder sends them: counting normally, stuck, or
+        /// jumping anywhere in the counter's range.
+        fn ticks() -> impl Strategy<Value = Vec<(i64, i64, f64)>> {
+            proptest::collection::vec(
+                (
+                    prop_oneof![
+                        4 => (-200i64..200, -200i64..200),
+                        1 => Just((0i64, 0i64)),
+                        1 => (-10_000_000i64..10_000_000, -10_000_000i64..10_000_000),
+                        1 => (any::<i64>(), any::<i64>()),
+                    ],
+                    extreme_f64(),
+                ),
+                1..30,
+            )
+            .prop_map(|steps| {
+                let (mut l, mut r) = (0i64, 0i64);
+                steps
+                    .into_iter()
+                    .map(|((dl, dr), steer)| {
+                        (l, r) = (l.wrapping_add(dl), r.wrapping_add(dr));
+                        (l, r, steer)
+                    })
+                    .collect()
+            })
+        }
+
+        proptest! {
+            #![proptest_config(config(256))]
+
+            /// Whatever the counters do and the steering angle reads, the odometry pose and
+            /// every pose of its trail stay finite.
+            #[test]
+            fn odometry_stays_finite_under_encoder_faults(
+                car in any::<bool>(),
+                readings in ticks(),
+            ) {
+                let model = if car {
+                    OdometryModel::Ackermann { wheel_radius: 0.05, wheelbase: 0.35 }
+                } else {
+                    OdometryModel::DiffDrive {
+                        left_radius: 0.1,
+                        right_radius: 0.1,
+                        wheel_base: 0.5,
+                    }
+                };
+                let mut o = WheelOdometry::new(model, 4096, Pose2::IDENTITY);
+                for (k, (l, r, steer)) in readings.into_iter().enumerate() {
+                    o.update(l, r, steer, k as f64 * 0.02);
+                    let p = o.pose;
+                    prop_assert!(p.x.is_finite() && p.y.is_finite() && p.theta.is_finite(), "{p:?}");
+                    let q = o.pose_at(k as f64 * 0.02 + 0.01);
+                    prop_assert!(q.x.is_finite() && q.y.is_finite() && q.theta.is_finite(), "{q:?}");
+                }
+            }
+        }
     }
 }

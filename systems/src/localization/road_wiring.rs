@@ -107,7 +107,7 @@ pub fn run_road_localizers(
         let loc = &mut *loc;
         for r in &enc.readings {
             if let Some(prev) = loc.last_ticks {
-                loc.odometer += (r.left_ticks - prev) as f64 * loc.metres_per_tick;
+                loc.odometer += r.left_ticks.wrapping_sub(prev) as f64 * loc.metres_per_tick;
             }
             loc.last_ticks = Some(r.left_ticks);
         }

@@ -40,6 +40,14 @@ use crate::world::OccupancyGrid;
 /// Cells per growth block along each axis.
 pub const BLOCK: usize = 64;
 
+/// The most cells a growing map grows to (the largest map a world may have). A scan that would
+/// take it past that, or beyond [`MAX_COORDINATE`], is inserted into the map as it is: a pose
+/// kilometres off (an odometry jump) must not allocate the space in between.
+pub const MAX_CELLS: usize = 400_000_000;
+
+/// How far from the world's origin (m) a growing map reaches, so cell indices stay integers.
+pub const MAX_COORDINATE: f64 = 1e9;
+
 /// An occupancy grid of log-odds, filled by [`LogOddsMap::insert_scan`].
 #[derive(Clone, Debug)]
 pub struct LogOddsMap {
@@ -222,6 +230,9 @@ impl LogOddsMap {
     /// and every beam's end point: not the full range circle, so a scan in a corridor does not
     /// allocate the space beyond its walls.
     fn grow_to_hold(&mut self, lo: [f64; 2], hi: [f64; 2]) {
+        if !self.may_grow_to_hold(lo, hi) {
+            return;
+        }
         let [c0, r0] = self.extent.cell_coords(lo[0], lo[1]);
         let [c1, r1] = self.extent.cell_coords(hi[0], hi[1]);
         let want = [c0 - 1, r0 - 1, c1 + 2, r1 + 2];
@@ -232,6 +243,26 @@ impl LogOddsMap {
             self.cells = cells;
             self.stamps = stamps;
         }
+    }
+
+    /// Whether the grid grown to hold the box [lo, hi] stays within [`MAX_CELLS`] and
+    /// [`MAX_COORDINATE`] (sizes in f64, so nothing overflows on the way).
+    fn may_grow_to_hold(&self, lo: [f64; 2], hi: [f64; 2]) -> bool {
+        let e = &self.extent;
+        let (mut lo, mut hi) = (lo, hi);
+        if e.width > 0 && e.height > 0 {
+            let o = e.origin();
+            lo = [lo[0].min(o[0]), lo[1].min(o[1])];
+            hi = [
+                hi[0].max(o[0] + e.width as f64 * e.resolution),
+                hi[1].max(o[1] + e.height as f64 * e.resolution),
+            ];
+        }
+        let margin = 2.0 * BLOCK as f64 + 3.0;
+        let cells =
+            ((hi[0] - lo[0]) / e.resolution + margin) * ((hi[1] - lo[1]) / e.resolution + margin);
+        let reach = lo.iter().chain(&hi).fold(0.0f64, |m, v| m.max(v.abs()));
+        cells <= MAX_CELLS as f64 && reach <= MAX_COORDINATE
     }
 
     /// P(occupied) per cell (0.5 = never observed).

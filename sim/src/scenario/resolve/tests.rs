@@ -99,3 +99,25 @@ fn the_grid_sized_without_allocating_is_the_one_measured_before() {
         }
     }
 }
+
+/// Zero-length time steps are refused: `dt` 0, negative, NaN, infinite (and over 1 s), in a
+/// file and from the builder alike, with an error naming the key and the value.
+#[test]
+fn a_zero_negative_or_nan_time_step_is_refused() {
+    use crate::scenario::Scenario;
+    parse(&format!("dt = 0.05\n{TEST_ROOM}")).unwrap();
+    for dt in ["0.0", "-0.05", "nan", "inf", "-inf", "1.5"] {
+        let e = parse(&format!("dt = {dt}\n{TEST_ROOM}")).unwrap_err();
+        assert!(e.contains("t.toml:1") && e.contains("`dt`"), "{dt}: {e}");
+        assert!(e.contains("(0, 1]"), "{dt}: {e}");
+    }
+    for dt in [0.0, -0.05, f64::NAN, f64::INFINITY] {
+        let built = Scenario::builder("steps")
+            .dt(dt)
+            .duration(1.0)
+            .room([0.0, 0.0], [10.0, 8.0])
+            .build();
+        let e = built.map(|_| ()).unwrap_err().to_string();
+        assert!(e.contains("`dt`") && e.contains("(0, 1]"), "{dt}: {e}");
+    }
+}

@@ -32,6 +32,7 @@ use crate::core::{Pose2, wrap_angle};
 use correction::PaddedField;
 use layout::{Layout, Span};
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct MarkovGridConfig {
@@ -132,6 +133,19 @@ fn argmax(v: &[f32]) -> Option<(usize, f32)> {
     Some((i, v[i]))
 }
 
+/// The endpoints of `points` a cell can see: finite and within the map's diagonal. Borrowed
+/// when that is all of them (a scan of the map always is).
+fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32; 2]]> {
+    let g = &map.grid;
+    let diagonal = (g.width as f64 * g.resolution).hypot(g.height as f64 * g.resolution);
+    let ok = |p: &[f32; 2]| (p[0] as f64).hypot(p[1] as f64) <= diagonal;
+    if points.iter().all(ok) {
+        Cow::Borrowed(points)
+    } else {
+        Cow::Owned(points.iter().copied().filter(ok).collect())
+    }
+}
+
 /// A cell centre `(x, y, heading offset, belief)` in the estimate's neighbourhood.
 type WeightedCell = (f64, f64, f64, f64);
 
@@ -215,12 +229,22 @@ impl MarkovGrid {
         std::mem::swap(&mut self.belief, &mut self.scratch);
         // the trilinear split already spreads ~1/6 cell² on average
         let extra = |sigma: f64| (sigma * sigma - 1.0 / 6.0).max(0.0).sqrt();
-        let s_xy = extra(d.sd_trans.hypot(d.trans * d.sd_rot1) / self.layout.resolution);
+        // a blur as wide as the grid already spreads the mass over all of it: capped there, so
+        // a jump of the odometry does not ask for a kernel as long as the jump
+        let (l, most) = (&self.layout, |s: f64, n: usize| s.min(n as f64));
+        let s_xy = most(
+            extra(d.sd_trans.hypot(d.trans * d.sd_rot1) / l.resolution),
+            l.nx.max(l.ny),
+        );
         if s_xy > 0.25 {
             let k = prediction::kernel(s_xy);
             prediction::blur_xy(&self.layout, &k, &mut self.belief, &mut self.tmp);
         }
-        let s_th = extra(d.sd_rot1.hypot(d.sd_rot2) / self.layout.theta_step());
+        let l = &self.layout;
+        let s_th = most(
+            extra(d.sd_rot1.hypot(d.sd_rot2) / l.theta_step()),
+            l.n_theta,
+        );
         if s_th > 0.25 {
             let k = prediction::kernel(s_th);
             prediction::blur_theta(&self.layout, &k, &self.belief, &mut self.scratch);
@@ -336,7 +360,11 @@ impl MarkovGrid {
     }
 
     /// Correction of the belief by a scan's endpoints (base frame, max-range readings left out).
+    /// Endpoints that are not finite, or farther than the map's diagonal (outside the map seen
+    /// from every cell, so they weigh every cell alike), are left out.
     pub fn apply_scan(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+        let points = reachable(map, points);
+        let points = &points[..];
         if points.is_empty() {
             return;
         }
@@ -433,6 +461,8 @@ impl MarkovGrid {
         points: &[[f32; 2]],
         range_max: f32,
     ) -> bool {
+        let points = reachable(map, points);
+        let points = &points[..];
         self.apply_scan(map, points, range_max);
         self.updates += 1;
         self.estimate = self.estimate_pose().map(|mut e| {

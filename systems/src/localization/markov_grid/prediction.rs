@@ -18,10 +18,13 @@ pub fn shift(layout: &Layout, d: &OdometryDelta, src: &[f32], dst: &mut [f32]) {
     let dk = (d.rot1 + d.rot2) / step;
     let dk0 = dk.floor();
     let wk = (dk - dk0) as f32;
+    // a shift past the grid's extent drops all the mass, as any longer one: clamped there so
+    // the cell arithmetic stays within integers
+    let beyond = (layout.nx + layout.ny + 2) as f64;
     for k in 0..nt {
         let th = layout.theta(k) + d.rot1;
-        let sx = d.trans * th.cos() / layout.resolution;
-        let sy = d.trans * th.sin() / layout.resolution;
+        let sx = (d.trans * th.cos() / layout.resolution).clamp(-beyond, beyond);
+        let sy = (d.trans * th.sin() / layout.resolution).clamp(-beyond, beyond);
         let (ix, iy) = (sx.floor(), sy.floor());
         let (fx, fy) = ((sx - ix) as f32, (sy - iy) as f32);
         let (ix, iy) = (ix as isize, iy as isize);

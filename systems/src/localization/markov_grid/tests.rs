@@ -169,3 +169,139 @@ fn argmax_is_total_cmp_s_first_maximum() {
         }
     }
 }
+
+/// Endpoints that are not finite or lie farther than the map reaches are dropped before
+/// scoring: an infinite endpoint once sized the padded field to the whole address space.
+#[test]
+fn endpoints_beyond_the_map_or_not_finite_do_not_size_the_field() {
+    let map = crate::localization::props::room();
+    let mut grid = MarkovGrid::new(MarkovGridConfig::default(), &map);
+    let good = [[1.0f32, 0.5], [-2.0, 1.0]];
+    let mut with_bad = good.to_vec();
+    with_bad.extend([
+        [f32::INFINITY, 0.0],
+        [f32::NAN, 1.0],
+        [1e30, -1e30],
+        [1e5, 0.0],
+    ]);
+    grid.apply_scan(&map, &with_bad, 10.0);
+    let reach = grid.field.as_ref().map(|f| f.reach).unwrap_or(0.0);
+    assert!(reach < 20.0, "{reach}");
+    assert!(grid.belief.iter().all(|p| p.is_finite() && *p >= 0.0));
+    // the same as the finite, reachable endpoints alone
+    let mut only_good = MarkovGrid::new(MarkovGridConfig::default(), &map);
+    only_good.apply_scan(&map, &good, 10.0);
+    assert_eq!(grid.belief, only_good.belief);
+}
+
+/// Properties under sensor faults: the belief stays a finite distribution and the estimate
+/// finite with a covariance, whatever the laser sends and however the odometry jumps.
+mod props {
+    use super::*;
+    use crate::core::props::{config, laser_fault, range_reading};
+    use crate::localization::props::{estimate_fault, room, room_scan};
+    use proptest::prelude::*;
+
+    fn belief_fault(b: &[f32]) -> Option<String> {
+        if let Some(bad) = b.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            return Some(format!("cell {bad}"));
+        }
+        let sum: f64 = b.iter().map(|&v| v as f64).sum();
+        ((sum - 1.0).abs() > 1e-3).then(|| format!("belief sums to {sum}"))
+    }
+
+    fn small() -> MarkovGridConfig {
+        MarkovGridConfig {
+            angular_bins: 12,
+            resolution: 0.5,
+            update_min_d: 0.0,
+            update_min_a: 0.0,
+            init: InitialBelief::Gaussian {
+                pose: Pose2::new(6.0, 4.0, 0.3),
+                sd: [0.5, 0.5, 0.2],
+            },
+            ..MarkovGridConfig::default()
+        }
+    }
+
+    proptest! {
+        #![proptest_config(config(48))]
+
+        /// The correction kernel with arbitrary endpoints (NaN, ±∞, huge) and range limits.
+        #[test]
+        fn any_endpoints_leave_a_finite_distribution(
+            points in proptest::collection::vec(
+                (range_reading(10.0), range_reading(10.0)), 0..40),
+            range_max in prop_oneof![Just(10.0f32), Just(0.0f32), Just(f32::MAX), 0.01f32..30.0],
+            selective in prop_oneof![Just(0.0), Just(1e-6)],
+        ) {
+            let map = room();
+            let mut grid = MarkovGrid::new(
+                MarkovGridConfig { selective_threshold: selective, ..small() }, &map);
+            let points: Vec<[f32; 2]> = points.iter().map(|p| [p.0, p.1]).collect();
+            prop_assert!(grid.correct_points(&map, &points, range_max));
+            prop_assert_eq!(belief_fault(&grid.belief), None);
+            let e = grid.estimate();
+            prop_assert!(e.is_some());
+            prop_assert_eq!(e.and_then(|e| estimate_fault(&e)), None);
+        }
+
+        /// A drive in the room with laser faults and odometry that sticks or jumps.
+        #[test]
+        fn the_grid_stays_finite_under_laser_faults_and_odometry_jumps(
+            steps in proptest::collection::vec(
+                (proptest::option::of(laser_fault(10.0, 40)),
+                 prop_oneof![
+                     4 => (-0.5f64..0.5, -0.1f64..0.1, -0.5f64..0.5),
+                     1 => Just((0.0, 0.0, 0.0)),
+                     1 => (-1e6f64..1e6, -1e6f64..1e6, -1e3f64..1e3),
+                 ]),
+                1..8),
+        ) {
+            let map = room();
+            let mut grid = MarkovGrid::new(small(), &map);
+            let mut truth = Pose2::new(6.0, 4.0, 0.3);
+            let mut odom = Pose2::IDENTITY;
+            let mut last: Option<Vec<f32>> = None;
+            for (fault, (dx, dy, dth)) in steps {
+                let step = Pose2::new(dx, dy, dth);
+                odom = odom.compose(&step);
+                if dx.abs() < 1.0 {
+                    truth = truth.compose(&step);
+                }
+                let mut scan = room_scan(&map, &truth, 90);
+                if let Some(f) = &fault {
+                    f.apply(&mut scan.ranges, 10.0, last.as_deref());
+                }
+                last = Some(scan.ranges.clone());
+                let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 30);
+                grid.predict(&odom);
+                grid.correct(&map, &beams);
+                prop_assert_eq!(belief_fault(&grid.belief), None);
+                let e = grid.estimate();
+                prop_assert!(e.is_some());
+                prop_assert_eq!(e.and_then(|e| estimate_fault(&e)), None);
+            }
+        }
+    }
+}
+
+/// An odometry jump of kilometres spreads the belief over the grid: the blur's width is capped
+/// at the grid's (it asked for a kernel as long as the jump and the allocation failed).
+#[test]
+fn an_odometry_jump_blurs_no_wider_than_the_grid() {
+    let map = crate::localization::props::room();
+    let mut grid = MarkovGrid::new(
+        MarkovGridConfig {
+            resolution: 0.5,
+            angular_bins: 12,
+            ..MarkovGridConfig::default()
+        },
+        &map,
+    );
+    grid.apply_motion(&Pose2::IDENTITY, &Pose2::new(3e5, -4e5, 2.0));
+    let sum: f64 = grid.belief.iter().map(|&v| v as f64).sum();
+    assert!(grid.belief.iter().all(|p| p.is_finite() && *p >= 0.0));
+    assert!((sum - 1.0).abs() < 1e-3, "{sum}");
+    assert!(grid.estimate_pose().is_some());
+}

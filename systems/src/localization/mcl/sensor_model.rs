@@ -54,7 +54,8 @@ impl Default for LaserModelParams {
 /// The beams a filter update uses: `max_beams` evenly spaced over the scan (AMCL's step
 /// (n − 1)/(max_beams − 1)), as (range, bearing in the base frame) and the endpoint in the base
 /// frame. A beam with no return (+Inf) is kept as a max-range reading; one below the minimum
-/// range (−Inf) or NaN is dropped.
+/// range (−Inf, or a finite reading under `range_min`, such as the zeros or negative values of
+/// a faulty scanner) or NaN is dropped.
 #[derive(Clone, Debug, Default)]
 pub struct BeamSubset {
     /// Range per beam (m); `range_max` for no return.
@@ -89,7 +90,7 @@ impl BeamSubset {
         for j in 0..picks {
             let k = ((j as f64 * step).round() as usize).min(n - 1);
             let r = scan.ranges[k];
-            if r.is_nan() || r == f32::NEG_INFINITY {
+            if r.is_nan() || r < scan.range_min.max(0.0) {
                 continue;
             }
             let max_reading = r == f32::INFINITY || r >= scan.range_max;
@@ -121,6 +122,12 @@ impl BeamSubset {
 
     pub fn is_empty(&self) -> bool {
         self.ranges.is_empty()
+    }
+
+    /// Whether some beam returned something: without one (every reading NaN, zero, below the
+    /// minimum or at the maximum range) the scan says nothing about where the robot is.
+    pub fn has_returns(&self) -> bool {
+        self.max_reading.iter().any(|max| !max)
     }
 }
 

@@ -263,3 +263,153 @@ fn the_first_estimate_is_the_built_cloud_s_whenever_it_is_asked_for() {
         cluster::dominant_cluster(&moved.xs, &moved.ys, &moved.ths, &moved.w, &config.bins);
     assert_eq!(moved.estimate(), corrected);
 }
+
+/// Properties under sensor faults: whatever the laser sends and however the odometry jumps, the
+/// beams a filter reads are finite, the weights stay normalised and every estimate is finite
+/// with a covariance.
+mod props {
+    use super::*;
+    use crate::core::props::{config, extreme_f64, laser_fault, range_reading};
+    use crate::localization::props::{estimate_fault, room, room_scan, weights_fault};
+    use crate::sensors::LaserScan;
+    use proptest::prelude::*;
+
+    /// A scan of the room's geometry with arbitrary readings.
+    fn garbage_scan(ranges: Vec<f32>) -> LaserScan {
+        let n = ranges.len().max(2);
+        LaserScan {
+            stamp: 0.0,
+            angle_min: -2.0,
+            angle_increment: 4.0 / (n - 1) as f32,
+            range_min: 0.1,
+            range_max: 10.0,
+            ranges,
+        }
+    }
+
+    /// A small filter that still does everything the full one does (KLD, injection, challenge).
+    fn small(model: LaserModel) -> MclConfig {
+        MclConfig {
+            min_particles: 50,
+            max_particles: 300,
+            model,
+            injection_candidates: 300,
+            challenge_every: 2,
+            update_min_d: 0.0,
+            update_min_a: 0.0,
+            init: InitialBelief::Gaussian {
+                pose: Pose2::new(6.0, 4.0, 0.3),
+                sd: [0.3, 0.3, 0.1],
+            },
+            ..MclConfig::default()
+        }
+    }
+
+    fn model() -> impl Strategy<Value = LaserModel> {
+        prop_oneof![Just(LaserModel::LikelihoodField), Just(LaserModel::Beam)]
+    }
+
+    proptest! {
+        #![proptest_config(config(256))]
+
+        #[test]
+        fn beam_subsets_of_any_scan_are_finite_returns_within_the_range(
+            ranges in proptest::collection::vec(range_reading(10.0), 0..120),
+            max_beams in 0usize..80,
+            mount in (-0.5f64..0.5, -0.5f64..0.5, -3.2f64..3.2),
+        ) {
+            let scan = garbage_scan(ranges);
+            let mount = Pose2::new(mount.0, mount.1, mount.2);
+            let b = BeamSubset::from_scan(&scan, &mount, max_beams);
+            prop_assert!(b.len() <= max_beams);
+            prop_assert_eq!(b.max_reading.len(), b.len());
+            prop_assert_eq!(b.points.len(), b.len());
+            for k in 0..b.len() {
+                let r = b.ranges[k];
+                prop_assert!(r.is_finite() && r >= scan.range_min && r <= scan.range_max, "{r}");
+                prop_assert!(b.angles[k].is_finite());
+                prop_assert!(b.points[k].iter().all(|v| v.is_finite()));
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(config(48))]
+
+        /// The likelihood-field kernel on arbitrary endpoints and particle poses (NaN, ±∞,
+        /// huge): every factor finite and at least 1.
+        #[test]
+        fn the_field_kernel_scores_any_endpoint_finite(
+            points in proptest::collection::vec(
+                (range_reading(10.0), range_reading(10.0)), 0..40),
+            poses in proptest::collection::vec(
+                (extreme_f64(), extreme_f64(), extreme_f64()), 1..40),
+        ) {
+            let map = room();
+            let table = sensor_model::likelihood_table(
+                &map.field, &LaserModelParams::default(), 10.0);
+            let points: Vec<[f32; 2]> = points.iter().map(|p| [p.0, p.1]).collect();
+            let xs: Vec<f64> = poses.iter().map(|p| p.0).collect();
+            let ys: Vec<f64> = poses.iter().map(|p| p.1).collect();
+            let ths: Vec<f64> = poses.iter().map(|p| p.2).collect();
+            let mut w = vec![1.0; xs.len()];
+            sensor_model::weigh_likelihood_field(&map.field, &table, &points, &xs, &ys, &ths, &mut w);
+            prop_assert!(w.iter().all(|v| v.is_finite() && *v >= 1.0), "{w:?}");
+        }
+
+        /// Weighing by any scan, with either model, leaves the weights normalised.
+        #[test]
+        fn weighing_any_scan_keeps_the_weights_normalised(
+            model in model(),
+            ranges in proptest::collection::vec(range_reading(10.0), 1..80),
+        ) {
+            let map = room();
+            let mut mcl = Mcl::new(small(model), &map, stream_rng(1, "props", "mcl"));
+            let beams = BeamSubset::from_scan(&garbage_scan(ranges), &Pose2::IDENTITY, 60);
+            let factor = mcl.weigh(&map, &beams);
+            prop_assert!(factor.is_finite() && factor >= 0.0, "{factor}");
+            prop_assert_eq!(weights_fault(&mcl.w), None);
+        }
+
+        /// A drive in the room with laser faults and odometry that sticks or jumps: after every
+        /// update the particles are finite, the weights normalised, the estimate finite with a
+        /// covariance.
+        #[test]
+        fn mcl_stays_finite_under_laser_faults_and_odometry_jumps(
+            model in model(),
+            steps in proptest::collection::vec(
+                (proptest::option::of(laser_fault(10.0, 40)),
+                 prop_oneof![
+                     4 => (-0.3f64..0.3, -0.1f64..0.1, -0.3f64..0.3),
+                     1 => Just((0.0, 0.0, 0.0)),
+                     1 => (-1e6f64..1e6, -1e6f64..1e6, -1e3f64..1e3),
+                 ]),
+                1..12),
+        ) {
+            let map = room();
+            let mut mcl = Mcl::new(small(model), &map, stream_rng(2, "props", "mcl"));
+            let mut truth = Pose2::new(6.0, 4.0, 0.3);
+            let mut odom = Pose2::IDENTITY;
+            let mut last: Option<Vec<f32>> = None;
+            for (fault, (dx, dy, dth)) in steps {
+                let step = Pose2::new(dx, dy, dth);
+                odom = odom.compose(&step);
+                if dx.abs() < 1.0 {
+                    truth = truth.compose(&step);
+                }
+                let mut scan = room_scan(&map, &truth, 90);
+                if let Some(f) = &fault {
+                    f.apply(&mut scan.ranges, 10.0, last.as_deref());
+                }
+                last = Some(scan.ranges.clone());
+                let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 30);
+                mcl.update(&map, &beams, &odom);
+                prop_assert_eq!(weights_fault(&mcl.w), None);
+                prop_assert!(mcl.xs.iter().chain(&mcl.ys).chain(&mcl.ths).all(|v| v.is_finite()));
+                let e = MapLocalizer::estimate(&mcl);
+                prop_assert!(e.is_some());
+                prop_assert_eq!(e.and_then(|e| estimate_fault(&e)), None);
+            }
+        }
+    }
+}

@@ -409,3 +409,63 @@ fn kernels() {
     assert_eq!(out, vec![0, 0, 2, 3]);
     assert!((effective_sample_size(&[0.25; 4]) - 4.0).abs() < 1e-12);
 }
+
+/// Properties under GPS and encoder faults: fixes 10 km (and farther) off, none at all, a
+/// compass stuck on one azimuth or reading nothing, distances that stick or jump; every
+/// estimate stays finite, on its edge, with a confidence in [0, 1].
+mod props {
+    use super::*;
+    use crate::core::props::{config, extreme_f64};
+    use proptest::prelude::*;
+
+    fn observation() -> impl Strategy<Value = RoadObservation> {
+        let gps = prop_oneof![
+            2 => Just(None),
+            4 => (-20.0f64..100.0, -20.0f64..20.0).prop_map(|(x, y)| Some([x, y])),
+            1 => (0.0f64..TAU).prop_map(|a| Some([1e4 * a.cos(), 1e4 * a.sin()])),
+            1 => Just(Some([1e7, -1e7])),
+        ];
+        let distance = prop_oneof![
+            4 => 0.0f64..2.0,
+            1 => Just(0.0),
+            1 => -1e6f64..1e6,
+        ];
+        let compass = prop_oneof![
+            1 => Just(None),
+            2 => Just(Some(1.0f64)),
+            2 => (0.0f64..TAU).prop_map(Some),
+            1 => extreme_f64().prop_map(Some),
+        ];
+        (distance, gps, compass).prop_map(|(distance, gps, compass)| RoadObservation {
+            distance,
+            gps,
+            compass,
+        })
+    }
+
+    proptest! {
+        #![proptest_config(config(64))]
+
+        #[test]
+        fn road_estimates_stay_finite_under_gps_outliers_and_a_stuck_compass(
+            use_mcl in any::<bool>(),
+            steps in proptest::collection::vec(observation(), 1..30),
+        ) {
+            let g = thesis_graph();
+            let mut loc: Box<dyn RoadLocalizer> = if use_mcl {
+                Box::new(RoadMcl::new(RoadMclConfig::default()))
+            } else {
+                Box::new(RoadGrid::new(RoadGridConfig::default()))
+            };
+            let mut rng = stream_rng(9, "props", "road");
+            for obs in steps {
+                loc.update(&g, &obs, &mut rng);
+                if let Some(e) = loc.estimate() {
+                    prop_assert!(e.xy.iter().all(|v| v.is_finite()), "{e:?}");
+                    prop_assert!(e.azimuth.is_finite() && e.remaining.is_finite(), "{e:?}");
+                    prop_assert!((0.0..=1.0).contains(&e.confidence), "{e:?}");
+                }
+            }
+        }
+    }
+}

@@ -267,3 +267,68 @@ fn the_reported_window_holds_every_cell_a_scan_changed() {
     // and it is not the whole map: the box of what the scan reached
     assert!((c1 - c0) * (r1 - r0) <= w * h);
 }
+
+/// A scan from a pose kilometres away (an odometry jump) is not allowed to grow the map over
+/// the space in between: the map stays as it was, finite (it asked for an allocation as large
+/// as the jump).
+#[test]
+fn a_scan_from_kilometres_away_does_not_grow_the_map_over_the_gap() {
+    let grid = room();
+    let mut map = LogOddsMap::new(0.05, OccupancyParams::default());
+    let pose = Pose2::new(1.0, 1.0, 0.0);
+    map.insert_scan(&pose, &cast(&grid, &pose));
+    let (w, h) = (map.width(), map.height());
+    for far in [Pose2::new(1e7, -1e7, 0.3), Pose2::new(1e300, 0.0, 0.0)] {
+        map.insert_scan(&far, &cast(&grid, &pose));
+        assert_eq!((map.width(), map.height()), (w, h));
+    }
+    // an empty map far out is not grown either
+    let mut empty = LogOddsMap::new(0.05, OccupancyParams::default());
+    empty.insert_scan(&Pose2::new(2e9, 0.0, 0.0), &cast(&grid, &pose));
+    assert_eq!(empty.width() * empty.height(), 0);
+    assert!(map.log_odds().iter().all(|l| l.is_finite()));
+}
+
+/// Properties: whatever the scan and the sensor pose (NaN, ±∞, far away), every cell's log
+/// odds and probability stay finite and within the clamping limits.
+mod props {
+    use super::*;
+    use crate::core::props::{config, extreme_f64, laser_fault, range_reading};
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(config(48))]
+
+        #[test]
+        fn any_scan_from_any_pose_leaves_finite_cells(
+            scans in proptest::collection::vec(
+                (prop_oneof![
+                    3 => (-1.0f64..5.0, -1.0f64..3.0, -3.2f64..3.2),
+                    1 => (extreme_f64(), extreme_f64(), extreme_f64()),
+                 ],
+                 proptest::collection::vec(range_reading(8.0), 0..90),
+                 proptest::option::of(laser_fault(8.0, 30))),
+                1..6),
+            range_max in prop_oneof![Just(8.0f32), Just(f32::INFINITY), Just(0.0f32), 0.1f32..50.0],
+        ) {
+            let grid = room();
+            let mut map = LogOddsMap::new(0.1, OccupancyParams::default());
+            let limits = [log_odds(map.params().p_min), log_odds(map.params().p_max)];
+            for ((x, y, th), ranges, fault) in scans {
+                let pose = Pose2::new(x, y, th);
+                let mut s = if ranges.is_empty() { cast(&grid, &Pose2::new(1.0, 1.0, 0.0)) } else {
+                    scan(-PI, 2.0 * PI / ranges.len() as f32, range_max, ranges)
+                };
+                if let Some(f) = fault {
+                    f.apply(&mut s.ranges, 8.0, None);
+                }
+                map.insert_scan(&pose, &s);
+                prop_assert!(map.width() * map.height() <= MAX_CELLS);
+                for &l in map.log_odds() {
+                    prop_assert!(l.is_finite() && l >= limits[0] - 1e-6 && l <= limits[1] + 1e-6, "{l}");
+                }
+                prop_assert!(map.to_prob_grid().p.iter().all(|p| p.is_finite()));
+            }
+        }
+    }
+}
