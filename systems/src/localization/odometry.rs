@@ -218,10 +218,10 @@ mod tests {
             Pose2::IDENTITY,
         );
         o.update(i64::MAX - 10, i64::MAX - 10, 0.0, 0.0);
-        // ten ticks on, past the end of the range
-        o.update(i64::MIN, i64::MIN + 2, 0.0, 0.02);
+        // eleven ticks on each wheel, past the end of the range: straight ahead
+        o.update(i64::MIN, i64::MIN, 0.0, 0.02);
         assert!(
-            (o.pose.x - 10.0 * TAU / 1000.0 * 0.1).abs() < 1e-3,
+            (o.pose.x - 11.0 * TAU / 1000.0 * 0.1).abs() < 1e-12 && o.pose.theta == 0.0,
             "{:?}",
             o.pose
         );
