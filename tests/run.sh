@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of the workspace, in release mode, then the Python package's tests, then a
-# short fuzzing pass over every reader of user files.
+# sharded batch on a one-node Slurm cluster, then a short fuzzing pass over every reader of user
+# files.
 #
 # The recording checks use the real Rerun 0.36.3 tools (`rerun rrd verify`, `rerun rrd stats` and
 # the Python SDK's RrdReader), Foxglove's Python MCAP readers (mcap, mcap-ros2-support) and evo
@@ -53,6 +54,10 @@ python3 -m venv "$py_venv"
 echo "building and installing the Python package into a fresh virtual environment"
 "$py_venv/bin/pip" install --quiet --disable-pip-version-check "./sim/python[test,gym]"
 (cd sim/python && "$py_venv/bin/python" -m pytest -p no:cacheprovider -q tests)
+
+# Shards on a real scheduler: a one-node Slurm cluster made on the spot runs a batch as a job
+# array of 4 shards (tests/slurm/shard.sbatch); the merged shards must equal the batch run whole.
+SIM_BIN="${CARGO_TARGET_DIR:-target}/release/sim" tests/slurm/run.sh
 
 # Fuzzing (tests/fuzz, cargo fuzz on the stable toolchain): each reader of user files runs its
 # seeds and every input that once failed, then 15 s of coverage-guided mutations. The long run
