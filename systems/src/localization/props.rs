@@ -3,11 +3,12 @@
 //! pass whatever the sensors sent.
 
 use super::map::LocalizationMap;
-use super::mcl::PoseEstimate;
+use super::mcl::{BeamSubset, PoseEstimate};
 use crate::core::Pose2;
-use crate::core::props::{all_finite, is_covariance};
+use crate::core::props::{LaserFault, all_finite, is_covariance};
 use crate::sensors::LaserScan;
 use crate::world::{Cell, OccupancyGrid};
+use proptest::prelude::*;
 
 /// A 12 m × 8 m room at 5 cm with a pillar and a wall stub (so a pose is well defined).
 pub fn room_grid() -> OccupancyGrid {
@@ -61,6 +62,44 @@ pub fn room_scan(map: &LocalizationMap, pose: &Pose2, beams: usize) -> LaserScan
         range_max: 10.0,
         ranges,
     }
+}
+
+/// An odometry step of a drive in the room: mostly a move of at most `small` (m, and rad), now
+/// and then none (stuck encoders) or a jump of up to a thousand kilometres.
+pub fn odometry_step(small: f64) -> impl Strategy<Value = Pose2> {
+    prop_oneof![
+        4 => (-small..small, -0.1f64..0.1, -small..small),
+        1 => Just((0.0, 0.0, 0.0)),
+        1 => (-1e6f64..1e6, -1e6f64..1e6, -1e3f64..1e3),
+    ]
+    .prop_map(|(x, y, theta)| Pose2::new(x, y, theta))
+}
+
+/// A drive through the room from (6, 4, 0.3): per step, the odometry pose and 30 beams of the
+/// 90-beam scan taken at the true pose with the step's laser fault, if any (a stuck laser
+/// repeats the scan before). A step of a metre or more is an odometry jump: the robot itself
+/// stays.
+pub fn faulted_drive(
+    map: &LocalizationMap,
+    steps: &[(Option<LaserFault>, Pose2)],
+) -> Vec<(Pose2, BeamSubset)> {
+    let mut truth = Pose2::new(6.0, 4.0, 0.3);
+    let mut odom = Pose2::IDENTITY;
+    let mut last: Option<Vec<f32>> = None;
+    let mut out = Vec::with_capacity(steps.len());
+    for (fault, step) in steps {
+        odom = odom.compose(step);
+        if step.x.abs() < 1.0 {
+            truth = truth.compose(step);
+        }
+        let mut scan = room_scan(map, &truth, 90);
+        if let Some(f) = fault {
+            f.apply(&mut scan.ranges, 10.0, last.as_deref());
+        }
+        last = Some(scan.ranges.clone());
+        out.push((odom, BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 30)));
+    }
+    out
 }
 
 /// Why an estimate is unfit to publish (a pose or covariance not finite, a covariance not
