@@ -2,7 +2,8 @@
 # Fuzzes every reader of user files with cargo fuzz (libFuzzer, coverage-guided, built on the
 # stable toolchain with `--sanitizer none`).
 #
-#   tests/fuzz/run.sh [SECONDS] [TARGET...]     default: 600 s per target, every target
+#   tests/fuzz/run.sh [SECONDS] [TARGET...]       default: 600 s per target, every target
+#   tests/fuzz/run.sh --runs N [TARGET...]        N inputs per target instead of a time
 #
 # Each target first runs every input of its seeds (tests/fuzz/seeds/<target>/: our own files
 # and every input that once failed), then mutates its working corpus (tests/fuzz/corpus/
@@ -14,8 +15,16 @@
 # Needs: cargo install cargo-fuzz (0.13). CARGO_TARGET_DIR is honoured.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-seconds="${1:-600}"
-shift || true
+if [ "${1:-}" = "--runs" ]; then
+    [ -n "${2:-}" ] || { echo "usage: $0 --runs N [TARGET...]" >&2; exit 2; }
+    limit=(-runs="$2")
+    what="$2 inputs"
+    shift 2
+else
+    limit=(-max_total_time="${1:-600}")
+    what="${1:-600} s"
+    shift || true
+fi
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
     targets=(scenario overrides map places roads carmen scans mcap batch)
@@ -26,14 +35,16 @@ log="$(mktemp)"
 trap 'rm -f "$log"' EXIT
 for t in "${targets[@]}"; do
     mkdir -p "tests/fuzz/corpus/$t" "tests/fuzz/artifacts/$t"
-    echo "== $t: its seeds, then ${seconds} s of fuzzing"
+    echo "== $t: its seeds, then $what of fuzzing"
+    start=$(date +%s)
     status=0
     cargo fuzz run --sanitizer none --fuzz-dir tests/fuzz -O "$t" \
         "tests/fuzz/corpus/$t" "tests/fuzz/seeds/$t" -- \
-        -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -malloc_limit_mb=2048 \
+        "${limit[@]}" -timeout=10 -rss_limit_mb=4096 -malloc_limit_mb=2048 \
         -max_len=262144 -print_final_stats=1 \
         -artifact_prefix="tests/fuzz/artifacts/$t/" >"$log" 2>&1 || status=$?
     grep -E "^stat::(number_of_executed_units|peak_rss_mb)|^INFO: seed corpus|^#[0-9]+ +DONE" "$log" || true
+    echo "$t: $(($(date +%s) - start)) s"
     if [ "$status" -ne 0 ] || [ -n "$(ls -A "tests/fuzz/artifacts/$t")" ]; then
         failed=1
         grep -v -e '^\s*\[' -e '^Output of' "$log" | cut -c1-300 | tail -40 >&2

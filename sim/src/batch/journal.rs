@@ -13,6 +13,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use systems::core::input::{MAX_DATA_BYTES, read_bounded};
 
 /// The rows' file in an output folder.
 pub const RUNS: &str = "runs.jsonl";
@@ -99,7 +100,7 @@ pub fn finished_rows(
         );
     }
     let path = dir.join(RUNS);
-    let text = match std::fs::read(&path) {
+    let text = match read_bounded(&path, MAX_DATA_BYTES) {
         Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
         // killed before its first run ended
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),

@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
+use systems::core::input::{MAX_CONFIG_BYTES, read_text_bounded};
 
 /// The file's name in the output folder.
 pub const FILE: &str = "batch.json";
@@ -40,7 +41,7 @@ impl Manifest {
     /// Reads the `batch.json` of `dir`, checking that its shard is one.
     pub fn read(dir: &Path) -> anyhow::Result<Manifest> {
         let path = dir.join(FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let text = read_text_bounded(&path, MAX_CONFIG_BYTES).map_err(|e| {
             anyhow::anyhow!(
                 "{}: cannot read: {e} (every output folder of sim batch has one; a folder \
                  written by an older sim has not: run that shard again)",

@@ -8,6 +8,7 @@ use super::output::{self, Row};
 use super::{BatchReport, aggregate, journal, manifest};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use systems::core::input::{MAX_DATA_BYTES, read_text_bounded};
 
 #[derive(clap::Args, Clone, Debug)]
 pub struct MergeArgs {
@@ -23,7 +24,7 @@ pub struct MergeArgs {
 
 fn read_rows(dir: &Path) -> anyhow::Result<Vec<Row>> {
     let path = dir.join(journal::RUNS);
-    let text = std::fs::read_to_string(&path)
+    let text = read_text_bounded(&path, MAX_DATA_BYTES)
         .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
     text.lines()
         .enumerate()

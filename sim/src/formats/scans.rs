@@ -28,6 +28,7 @@ use std::fmt;
 use std::io::{Read, Write};
 use std::path::Path;
 use systems::core::Pose2;
+use systems::core::input::{BoundedReader, MAX_DATA_BYTES, MAX_LINE_BYTES};
 use systems::matching::scan_to_points;
 use systems::sensors::LaserScan;
 
@@ -172,7 +173,9 @@ pub fn read_scans(path: &Path) -> Result<Vec<ScanRecord>, ScansError> {
         field: None,
         message: format!("cannot read the scans file: {e}"),
     })?;
-    parse_scans(std::io::BufReader::new(file), &name)
+    // rows are streamed, so the bound is on the file and on each line
+    let bounded = BoundedReader::new(file, MAX_DATA_BYTES, MAX_LINE_BYTES);
+    parse_scans(std::io::BufReader::new(bounded), &name)
 }
 
 /// Parses SCANS text from any reader; `name` is the file name used in errors.

@@ -12,6 +12,7 @@
 //! and the laser's mount; the SLAM starts at the first scan's odometry pose, so its map frame
 //! is the odometry frame at the start. Rear scans are not used. With `TRUEPOS` lines, the SLAM
 //! trajectory and the raw odometry are judged against them ([`eval`]).
+use systems::core::input::{MAX_CONFIG_BYTES, read_text_bounded};
 
 pub mod eval;
 pub mod feed;
@@ -161,7 +162,7 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     let config_text = match &a.slam_config {
         Some(p) => Some((
             p.display().to_string(),
-            std::fs::read_to_string(p)
+            read_text_bounded(p, MAX_CONFIG_BYTES)
                 .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", p.display()))?,
         )),
         None => None,

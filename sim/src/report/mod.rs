@@ -4,6 +4,7 @@
 //! - a run: `report.html` and `report.json` ([`data::RunReport`]: the summary, the simplified
 //!   paths, the error series and the task spans), which `sim report` draws again;
 //! - a batch: `report.html` in the batch's folder, drawn from its rows (`runs.jsonl`).
+use systems::core::input::{MAX_DATA_BYTES, read_text_bounded};
 
 pub mod batch;
 pub mod data;
@@ -93,7 +94,7 @@ fn read_input(path: &Path) -> anyhow::Result<(Input, PathBuf)> {
         let dir = path.parent().map_or_else(PathBuf::new, Path::to_path_buf);
         (path.to_path_buf(), dir)
     };
-    let text = std::fs::read_to_string(&file)
+    let text = read_text_bounded(&file, MAX_DATA_BYTES)
         .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", file.display()))?;
     let not_ours = |why: String| {
         anyhow::anyhow!(

@@ -4,6 +4,7 @@ use super::check::OdometrySource;
 use super::error::ScenarioError;
 use super::model::Scenario;
 use std::path::{Path, PathBuf};
+use systems::core::input::{MAX_CONFIG_BYTES, read_bounded};
 
 /// Loads and validates a scenario file.
 pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
@@ -25,7 +26,8 @@ pub fn read_scenario_text(path: &Path) -> Result<String, ScenarioError> {
         key: None,
         message,
     };
-    let bytes = std::fs::read(path).map_err(|e| error(None, None, format!("cannot read: {e}")))?;
+    let bytes = read_bounded(path, MAX_CONFIG_BYTES)
+        .map_err(|e| error(None, None, format!("cannot read: {e}")))?;
     String::from_utf8(bytes).map_err(|e| {
         let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line = good.iter().filter(|&&b| b == b'\n').count() + 1;

@@ -35,14 +35,30 @@ fn bare_key(k: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
+/// Most parts (keys and array items) an override's key may have.
+pub const MAX_KEY_PARTS: usize = 32;
+
 /// Parses a key path: keys separated by dots, array items as `.N`, `[N]` or `[key=value]`.
 pub fn parse_path(flag: &str, key: &str) -> anyhow::Result<Vec<Step>> {
+    let shown: String = if key.chars().count() > 80 {
+        key.chars().take(60).chain("…".chars()).collect()
+    } else {
+        key.to_string()
+    };
     let bad = |why: &str| {
         anyhow::anyhow!(
-            "{flag} {key}: {why} (expected keys separated by dots, array items as .N, [N] or \
+            "{flag} {shown}: {why} (expected keys separated by dots, array items as .N, [N] or \
              [name=VALUE], e.g. robots[name=r1].sensors.laser.rate)"
         )
     };
+    // scenario keys have a handful of parts; one of thousands would recurse as deep when
+    // applied and overflow the stack
+    let parts = key.split('.').count() + key.matches('[').count();
+    if parts > MAX_KEY_PARTS {
+        return Err(bad(&format!(
+            "{parts} parts, more than any scenario key has (at most {MAX_KEY_PARTS})"
+        )));
+    }
     let mut steps = Vec::new();
     for part in key.split('.') {
         let (base, mut rest) = match part.find('[') {

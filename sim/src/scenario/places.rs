@@ -10,6 +10,7 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use systems::core::Pose2;
+use systems::core::input::{MAX_CONFIG_BYTES, read_text_bounded};
 use systems::world::OccupancyGrid;
 
 /// Named places next to a map: `[places.<name>] pose = [x, y, yaw]`.
@@ -48,7 +49,7 @@ pub(super) fn load_places(
     ppath: &Path,
     grid: &OccupancyGrid,
 ) -> R<(BTreeMap<String, Pose2>, Vec<DoorConfig>)> {
-    let ptext = std::fs::read_to_string(ppath).map_err(|e| {
+    let ptext = read_text_bounded(ppath, MAX_CONFIG_BYTES).map_err(|e| {
         c.cx.at(key, format!("cannot read {}: {e}", ppath.display()))
     })?;
     let pcx = ErrorContext::new(ppath.display().to_string(), &ptext);

@@ -195,6 +195,39 @@ fn bad_input_exits_non_zero_with_a_clear_message() {
     );
 }
 
+/// Inputs with no end (a stream of zeros, a file without line ends) or no sensible size are
+/// refused at a stated bound, never read until memory runs out.
+#[test]
+fn endless_or_oversized_inputs_are_refused_at_their_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    expect_failure(
+        &["run", "/dev/zero", "--no-rrd"],
+        dir.path(),
+        &["/dev/zero: cannot read: larger than 64 MiB"],
+    );
+    expect_failure(
+        &["match", "/dev/zero", "--reference", "0", "--current", "1"],
+        dir.path(),
+        &["/dev/zero", "a line longer than 64 MiB"],
+    );
+    // one line of 65 MiB in a regular file
+    std::fs::write(dir.path().join("one.scans"), vec![b'7'; 65 << 20]).unwrap();
+    expect_failure(
+        &["match", "one.scans", "--reference", "0", "--current", "1"],
+        dir.path(),
+        &["one.scans", "a line longer than 64 MiB"],
+    );
+    // a --set key thousands of parts deep overflowed the stack when applied
+    let deep = format!("{}=1", vec!["a"; 5000].join("."));
+    expect_failure(
+        &[
+            "batch", "maze_run", "--seeds", "0..1", "--set", &deep, "--out", "deep",
+        ],
+        dir.path(),
+        &["--set a.a.a", "5000 parts", "at most 32"],
+    );
+}
+
 /// A run asked to save maps of a world with nothing to map fails before its first tick, not
 /// after the whole run.
 #[test]

@@ -6,6 +6,7 @@ pub mod cache;
 pub mod clock;
 pub mod cpu;
 pub mod ids;
+pub mod input;
 pub mod jobs;
 pub mod moments;
 pub mod normal;

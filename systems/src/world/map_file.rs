@@ -5,6 +5,7 @@
 //! row 0 is the TOP row.
 
 use super::grid::{Cell, OccupancyGrid};
+use crate::core::input::{MAX_CONFIG_BYTES, read_text_bounded};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -59,7 +60,7 @@ enum Mode {
 
 /// Loads a map_server YAML and its image.
 pub fn load_map(yaml_path: &Path) -> Result<OccupancyGrid, MapError> {
-    let text = std::fs::read_to_string(yaml_path).map_err(|source| MapError::Read {
+    let text = read_text_bounded(yaml_path, MAX_CONFIG_BYTES).map_err(|source| MapError::Read {
         path: yaml_path.to_path_buf(),
         source,
     })?;

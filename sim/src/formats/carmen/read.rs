@@ -7,6 +7,7 @@ use super::{CarmenError, CarmenLog, OdomRecord, RobotLaserInfo, ScanRecord, Scan
 use super::{Pose2, TruePosRecord};
 use std::f64::consts::PI;
 use std::path::Path;
+use systems::core::input::{MAX_DATA_BYTES, read_bounded};
 
 /// Geometry for old `FLASER`/`RLASER` lines, overriding the log's PARAMs. SI units.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -53,7 +54,7 @@ const ROBOTLASER2_FORMAT: &str = "ROBOTLASER2 laser_type start_angle field_of_vi
 /// them first); bytes that are not UTF-8 are replaced, which only matters inside skipped lines.
 pub fn read_carmen(path: &Path, opts: &CarmenReadOptions) -> Result<CarmenLog, CarmenError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|error| CarmenError::Io {
+    let bytes = read_bounded(path, MAX_DATA_BYTES).map_err(|error| CarmenError::Io {
         file: file.clone(),
         error,
     })?;

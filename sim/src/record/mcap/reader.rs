@@ -16,6 +16,7 @@ use super::schema::RosMessage;
 use super::writer::MESSAGE_ENCODING;
 use anyhow::anyhow;
 use std::path::Path;
+use systems::core::input::{MAX_DATA_BYTES, read_bounded};
 
 impl McapRecording {
     /// Reads a complete MCAP file; any damage is an error.
@@ -103,5 +104,5 @@ impl McapRecording {
 }
 
 fn read(path: &Path) -> anyhow::Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))
+    read_bounded(path, MAX_DATA_BYTES).map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))
 }

@@ -175,3 +175,21 @@ fn blames_the_override_on_the_error_path() {
     assert!(keys("dt").is_empty());
     assert!(keys("robots[0].slam_x").is_empty());
 }
+
+#[test]
+fn a_key_deeper_than_any_scenario_is_refused_before_it_is_applied() {
+    // 20 000 levels overflowed the stack when the override was applied
+    let deep = vec!["a"; 20_000].join(".");
+    let e = set(&deep, "1").unwrap_err().to_string();
+    assert!(
+        e.contains("20000 parts, more than any scenario key has (at most 32)"),
+        "{e}"
+    );
+    assert!(e.len() < 400, "the key is shortened in the message: {e}");
+    let brackets = format!("robots{}", "[0]".repeat(40));
+    let e = set(&brackets, "1").unwrap_err().to_string();
+    assert!(e.contains("41 parts"), "{e}");
+    // as deep as allowed: applied (as new nested tables), no overflow
+    let ok = vec!["a"; MAX_KEY_PARTS].join(".");
+    set(&ok, "1").unwrap();
+}

@@ -94,11 +94,15 @@ impl Navigator {
         }
         let v = self.follower.v;
         let mut lookahead = fp.lookahead + fp.lookahead_time * v.abs();
+        let diagonal = (map.width as f64).hypot(map.height as f64) * map.resolution;
         loop {
             let mut trial = fp;
             trial.lookahead = lookahead;
             trial.lookahead_time = 0.0;
-            let n = ((lookahead * 1.6) / (0.5 * map.resolution)).ceil().max(2.0) as usize;
+            // samples every half cell along the arc; the arc ends on the path, inside the map,
+            // so no longer than the map's diagonal is sampled (however long the look-ahead)
+            let reach = lookahead.min(diagonal);
+            let n = ((reach * 1.6) / (0.5 * map.resolution)).ceil().max(2.0) as usize;
             let arc = pursuit_arc(&self.path, self.follower.segment, pose, &trial, v, n);
             // (the robot's own cell may already be inscribed when squeezed through a doorway)
             let clear = arc.iter().skip(1).all(|q| {

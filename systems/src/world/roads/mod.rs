@@ -16,6 +16,7 @@
 //!
 //! Malformed input is an error with the file, line and column: not XML, a missing or
 //! non-numeric coordinate, a way referring to a node the file lacks, a bad width, no roads.
+use crate::core::input::{MAX_DATA_BYTES, read_text_bounded};
 
 pub mod geo;
 mod gpx;
@@ -45,7 +46,7 @@ pub struct GeoFrame(pub LocalProjection);
 
 /// Reads an OSM XML or GPX file (told apart by the root element).
 pub fn load_roads(path: &Path, options: &RoadOptions) -> Result<RoadGraph, RoadError> {
-    let text = std::fs::read_to_string(path).map_err(|source| RoadError::Read {
+    let text = read_text_bounded(path, MAX_DATA_BYTES).map_err(|source| RoadError::Read {
         path: path.to_path_buf(),
         source,
     })?;

@@ -206,3 +206,18 @@ fn bad_requests_are_typed_errors_naming_what_they_concern() {
     // nothing was queued by the refused commands: the run is that of the file
     assert_eq!(s.ticks(), 0);
 }
+
+#[test]
+fn a_look_ahead_longer_than_the_map_still_drives() {
+    // the clearance check samples the arc to the look-ahead point every half cell: sized from
+    // the look-ahead alone, 1e9 m asked for a terabyte; the arc ends on the path, in the map
+    let text = COURIER.replace(
+        "navigation = { speed = 0.8 }",
+        "navigation = { speed = 0.8, lookahead = 1e9 }",
+    );
+    let mut s = from_text(&text, "far").build().unwrap();
+    let start = s.robot("r1").unwrap().pose();
+    s.run_for(10.0).unwrap();
+    let end = s.robot("r1").unwrap().pose();
+    assert!(end.distance(&start) > 1.0, "{start:?} -> {end:?}");
+}
