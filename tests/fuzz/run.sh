@@ -7,7 +7,8 @@
 #
 # Each target first runs every input of its seeds (tests/fuzz/seeds/<target>/: our own files
 # and every input that once failed), then mutates its working corpus (tests/fuzz/corpus/
-# <target>/, not committed) for SECONDS. A failure is a panic or abort, an input that takes
+# <target>/, not committed) for SECONDS, with the dictionary tests/fuzz/dicts/<target>.dict where
+# there is one (tests/fuzz/make_dicts.sh). A failure is a panic or abort, an input that takes
 # more than 10 s, or an allocation over 2 GB (malloc_limit_mb); libFuzzer then writes the input
 # to tests/fuzz/artifacts/<target>/ and this script exits non-zero. Fix the cause, then copy
 # the input into seeds/<target>/ so it is replayed on every run.
@@ -37,10 +38,12 @@ for t in "${targets[@]}"; do
     mkdir -p "tests/fuzz/corpus/$t" "tests/fuzz/artifacts/$t"
     echo "== $t: its seeds, then $what of fuzzing"
     start=$(date +%s)
+    dict=()
+    [ ! -f "tests/fuzz/dicts/$t.dict" ] || dict=(-dict="tests/fuzz/dicts/$t.dict")
     status=0
     cargo fuzz run --sanitizer none --fuzz-dir tests/fuzz -O "$t" \
         "tests/fuzz/corpus/$t" "tests/fuzz/seeds/$t" -- \
-        "${limit[@]}" -timeout=10 -rss_limit_mb=4096 -malloc_limit_mb=2048 \
+        "${limit[@]}" "${dict[@]}" -timeout=10 -rss_limit_mb=4096 -malloc_limit_mb=2048 \
         -max_len=262144 -print_final_stats=1 \
         -artifact_prefix="tests/fuzz/artifacts/$t/" >"$log" 2>&1 || status=$?
     grep -E "^stat::(number_of_executed_units|peak_rss_mb)|^INFO: seed corpus|^#[0-9]+ +DONE" "$log" || true

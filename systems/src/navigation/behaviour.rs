@@ -97,7 +97,9 @@ impl Behaviour {
                     self.status = NavStatus::Arrived;
                     return None;
                 }
-                loop {
+                // one pass over the points at most: looping points that all lie within the
+                // tolerance of the robot leave nothing to do this tick (not an endless loop)
+                for _ in 0..=points.len() {
                     if self.current >= points.len() {
                         if *looping {
                             self.current = 0;
@@ -117,6 +119,7 @@ impl Behaviour {
                         wrap_angle((p[1] - belief.y).atan2(p[0] - belief.x) - belief.theta);
                     return Some((bearing, d));
                 }
+                None
             }
             BehaviourKind::Wander => {
                 if now >= self.next_wander_change {
@@ -214,4 +217,50 @@ pub fn drive_behaviours(
         },
     );
     memory.keep(jobs);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn looping_points_all_within_reach_leave_nothing_to_do_and_return() {
+        // every point within the tolerance of the robot: the search for the next point to
+        // drive to went round the loop for ever
+        let rng = crate::core::stream_rng(1, "r1", "behaviour");
+        let points = vec![[2.0, 2.0], [2.1, 2.0]];
+        let mut b = Behaviour::new(
+            BehaviourKind::Waypoints {
+                points: points.clone(),
+                looping: true,
+            },
+            0.5,
+            0.3,
+            rng.clone(),
+        );
+        b.tolerance = 0.5;
+        let here = Pose2::new(2.0, 2.0, 0.0);
+        assert_eq!(b.wanted_bearing(&here, 0.0), None);
+        assert_eq!(b.status, NavStatus::Driving);
+        // once away from them, it drives to the next one again
+        let away = Pose2::new(4.0, 2.0, 0.0);
+        let (bearing, d) = b.wanted_bearing(&away, 0.1).expect("a point to drive to");
+        assert!(
+            (bearing.abs() - PI).abs() < 1e-9 && d > 1.8,
+            "{bearing} {d}"
+        );
+        // not looping: arrived
+        let mut once = Behaviour::new(
+            BehaviourKind::Waypoints {
+                points,
+                looping: false,
+            },
+            0.5,
+            0.3,
+            rng,
+        );
+        once.tolerance = 0.5;
+        assert_eq!(once.wanted_bearing(&here, 0.0), None);
+        assert_eq!(once.status, NavStatus::Arrived);
+    }
 }
