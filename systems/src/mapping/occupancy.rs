@@ -40,10 +40,11 @@ use crate::world::OccupancyGrid;
 /// Cells per growth block along each axis.
 pub const BLOCK: usize = 64;
 
-/// The most cells a growing map grows to (the largest map a world may have). A scan that would
-/// take it past that, or beyond [`MAX_COORDINATE`], is inserted into the map as it is: a pose
-/// kilometres off (an odometry jump) must not allocate the space in between.
-pub const MAX_CELLS: usize = 400_000_000;
+/// The most cells a growing map grows to: 100 million, 0.8 GB of log-odds and scan stamps
+/// (500 × 500 m at 5 cm; a world's fixed grid, one byte a cell, may have 400 million). A scan
+/// that would take it past that, or beyond [`MAX_COORDINATE`], is inserted into the map as it
+/// is: a pose kilometres off (an odometry jump) must not allocate the space in between.
+pub const MAX_CELLS: usize = 100_000_000;
 
 /// How far from the world's origin (m) a growing map reaches, so cell indices stay integers.
 pub const MAX_COORDINATE: f64 = 1e9;
