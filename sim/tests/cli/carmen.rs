@@ -186,3 +186,38 @@ fn carmen_io_errors_say_read_or_write_and_give_the_cause_once() {
     );
     assert!(e.contains("nosuch: cannot read"), "{e}");
 }
+
+/// A log whose poses jump 58 km: every SLAM system maps both places without the space between
+/// (the RBPF's tile table grew to hold it and ran out of memory).
+#[test]
+fn a_log_whose_poses_jump_kilometres_maps_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let line = |x: f64, y: f64, t: f64| {
+        let ranges = vec!["3.0"; 181].join(" ");
+        format!("FLASER 181 {ranges} {x} {y} 0.0 {x} {y} 0.0 {t} host {t}\n")
+    };
+    let log = [
+        line(0.0, 0.0, 1.0),
+        line(0.1, 0.0, 1.1),
+        line(50_000.0, 30_000.0, 1.2),
+        line(50_000.1, 30_000.0, 1.3),
+    ]
+    .concat();
+    std::fs::write(dir.path().join("far.log"), log).unwrap();
+    for slam in ["scan_to_map", "rbpf", "graph"] {
+        let out = run_ok(
+            &["slam", "--carmen", "far.log", "--slam", slam, "--no-rrd"],
+            dir.path(),
+        );
+        let map = out.lines().find(|l| l.starts_with("map ")).unwrap_or("");
+        let cells: Vec<usize> = map
+            .split(|c: char| !c.is_ascii_digit())
+            .filter_map(|w| w.parse().ok())
+            .take(2)
+            .collect();
+        assert!(
+            cells.len() == 2 && cells[0] * cells[1] <= 1_000_000,
+            "{slam}: {map}"
+        );
+    }
+}

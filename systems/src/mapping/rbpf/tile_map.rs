@@ -13,6 +13,7 @@ use super::super::insert::{
     CellStore, GridFrame, InsertStats, LogOddsModel, apply_beams, beam_box, prepare_beams,
 };
 use super::super::inverse_model::{OccupancyParams, probability};
+use super::super::occupancy::MAX_CELLS;
 use crate::core::Pose2;
 use crate::matching::ProbGrid;
 use crate::sensors::LaserScan;
@@ -202,6 +203,12 @@ impl TileMap {
                 [thi[0].max(cur_hi[0]), thi[1].max(cur_hi[1])],
             )
         };
+        // as a growing map does: past MAX_CELLS (a pose kilometres off) the scan goes into the
+        // table as it is, without the space in between
+        let span = |i: usize| (n1[i] as f64 - n0[i] as f64 + 1.0) * TILE as f64;
+        if span(0) * span(1) > MAX_CELLS as f64 {
+            return;
+        }
         let (nw, nh) = ((n1[0] - n0[0] + 1) as usize, (n1[1] - n0[1] + 1) as usize);
         if n0 == self.t0 && nw == self.tw && nh == self.th {
             return;
