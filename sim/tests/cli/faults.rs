@@ -89,8 +89,8 @@ fn an_unwritable_summary_is_named_and_the_recording_is_still_complete() {
     }
 }
 
-/// Starts a long `sim run maze_run` writing both recordings, kills it with SIGKILL once the
-/// MCAP file has a few chunks, and returns when it is gone.
+/// Starts a long `sim run maze_run` writing both recordings, kills it with SIGKILL once both
+/// files have a few chunks, and returns when it is gone.
 fn killed_run(dir: &Path) {
     use std::os::unix::process::ExitStatusExt;
     let mut child = Command::new(env!("CARGO_BIN_EXE_sim"))
@@ -99,10 +99,12 @@ fn killed_run(dir: &Path) {
         .current_dir(dir)
         .spawn()
         .unwrap();
-    let mcap = dir.join("cut.mcap");
+    let size = |name: &str| std::fs::metadata(dir.join(name)).map_or(0, |m| m.len());
     let started = Instant::now();
-    // chunks end every 10 s of simulated time: 4 MB is well past the first few
-    while std::fs::metadata(&mcap).map_or(0, |m| m.len()) < 4_000_000 {
+    // MCAP chunks end every 10 s of simulated time and .rrd chunks at 1 MiB: 4 MB is well
+    // past the first few of each. The .rrd is written by background threads, which on a busy
+    // machine lag behind the MCAP file: both are waited for.
+    while size("cut.mcap") < 4_000_000 || size("cut.rrd") < 4_000_000 {
         assert!(started.elapsed() < Duration::from_secs(120), "no MCAP data");
         std::thread::sleep(Duration::from_millis(20));
     }
