@@ -53,12 +53,46 @@ pub fn load_roads(path: &Path, options: &RoadOptions) -> Result<RoadGraph, RoadE
     parse_roads(&text, path, options)
 }
 
+/// A parse error of roxmltree, located: where it happened, or the end of the text for a text
+/// that ends too soon (roxmltree gives those no position); said once, in front.
+fn xml_error(e: &roxmltree::Error, text: &str, path: &Path) -> RoadError {
+    use roxmltree::Error as E;
+    let message = e.to_string();
+    let (line, column, message) = match e {
+        E::UnexpectedEndOfStream | E::UnclosedRootNode | E::NoRootNode => {
+            let line = text.matches('\n').count() + 1;
+            let last = text.rsplit('\n').next().unwrap_or("");
+            let at = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+            (at(line), at(last.chars().count() + 1), message.as_str())
+        }
+        // limits of the document as a whole: no place to name
+        E::DtdDetected
+        | E::NodesLimitReached
+        | E::AttributesLimitReached
+        | E::NamespacesLimitReached => {
+            return RoadError::Content {
+                path: path.to_path_buf(),
+                message: format!("not well-formed XML: {message}"),
+            };
+        }
+        _ => {
+            let at = e.pos();
+            let suffix = format!(" at {}:{}", at.row, at.col);
+            let m = message.strip_suffix(&suffix).unwrap_or(&message);
+            (at.row, at.col, m)
+        }
+    };
+    RoadError::At {
+        path: path.to_path_buf(),
+        line,
+        column,
+        message: format!("not well-formed XML: {message}"),
+    }
+}
+
 /// Parses OSM XML or GPX text; `path` only names the source in errors.
 pub fn parse_roads(text: &str, path: &Path, options: &RoadOptions) -> Result<RoadGraph, RoadError> {
-    let doc = roxmltree::Document::parse(text).map_err(|e| RoadError::Xml {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
+    let doc = roxmltree::Document::parse(text).map_err(|e| xml_error(&e, text, path))?;
     let src = Source { doc: &doc, path };
     let raw = match doc.root_element().tag_name().name() {
         "osm" => osm::read(&src, options)?,

@@ -14,8 +14,6 @@ pub enum RoadError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path}: not well-formed XML: {message}")]
-    Xml { path: PathBuf, message: String },
     #[error("{path}:{line}:{column}: {message}")]
     At {
         path: PathBuf,

@@ -137,10 +137,12 @@ fn error_of(name: &str) -> String {
 
 #[test]
 fn malformed_files_give_clear_errors() {
+    // XML errors say where, once; a file that ends too soon, at its end
     let s = error_of("not_xml.osm");
     assert!(s.contains("not well-formed XML"), "{s}");
+    assert!(s.contains("not_xml.osm:") && !s.contains(" at "), "{s}");
     let s = error_of("truncated.gpx");
-    assert!(s.contains("not well-formed XML"), "{s}");
+    assert!(s.contains("truncated.gpx:5:22: not well-formed XML"), "{s}");
     let s = error_of("bad_lat.osm");
     assert!(s.contains(":4:") && s.contains("`lat` = \"north\""), "{s}");
     let s = error_of("missing_node.osm");
