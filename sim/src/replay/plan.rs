@@ -134,8 +134,23 @@ pub fn plan(a: &ReplayArgs, rec: &McapRecording) -> anyhow::Result<ReplayPlan> {
     let keep: Vec<_> = robots.iter().map(|&i| scenario.robots[i].clone()).collect();
     scenario.robots = keep;
     scenario.people.clear();
-    scenario.duration = recorded_length(&feeds, scenario.dt)
+    let (last, what) = last_reading(&feeds, &scenario)
         .ok_or_else(|| anyhow!("{}: no messages on the replayed topics", rec.path.display()))?;
+    // up to the last reading, whole ticks
+    scenario.duration = ((last / scenario.dt - 1e-6).ceil().max(1.0)) * scenario.dt;
+    // a stamp years ahead of the others (a clock unset, or a damaged stamp) would make the
+    // replay run for ever: refused before it starts, naming the reading
+    if crate::scenario::model::too_many_ticks(scenario.duration, scenario.dt).is_some() {
+        bail!(
+            "{}: {what} is stamped {last:.4e} s ({:.1} days) after the replay's start; at dt = \
+             {} s that is {:.3e} ticks, more than a run may have ({:.0e}): is its stamp wrong?",
+            rec.path.display(),
+            last / 86_400.0,
+            scenario.dt,
+            scenario.duration / scenario.dt,
+            crate::scenario::model::MAX_TICKS
+        );
+    }
     Ok(ReplayPlan {
         scenario,
         run,
@@ -178,19 +193,22 @@ fn pick_robots(a: &ReplayArgs, sc: &Scenario, own: bool) -> anyhow::Result<Vec<u
     )
 }
 
-/// The replay's length: up to the last reading, whole ticks.
-fn recorded_length(feeds: &[RobotFeed], dt: f64) -> Option<f64> {
-    let last = feeds
-        .iter()
-        .flat_map(|f| {
-            [
-                f.scans.last().map(|s| s.stamp),
-                f.encoder.last().map(|e| e.stamp),
-                f.odometry.last().map(|o| o.0),
-                f.truth.last().map(|t| t.0),
-            ]
-        })
-        .flatten()
-        .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.max(t))))?;
-    Some(((last / dt - 1e-6).ceil().max(1.0)) * dt)
+/// The latest reading of the replayed robots: its time (s since the replay's start) and what
+/// it is (`r1's laser scan`), for messages.
+fn last_reading(feeds: &[RobotFeed], sc: &Scenario) -> Option<(f64, String)> {
+    let mut last: Option<(f64, String)> = None;
+    for (f, robot) in feeds.iter().zip(&sc.robots) {
+        let kinds = [
+            (f.scans.last().map(|s| s.stamp), "laser scan"),
+            (f.encoder.last().map(|e| e.stamp), "encoder reading"),
+            (f.odometry.last().map(|o| o.0), "odometry pose"),
+            (f.truth.last().map(|t| t.0), "true pose"),
+        ];
+        for (t, kind) in kinds {
+            if let Some(t) = t.filter(|&t| last.as_ref().is_none_or(|l| t > l.0)) {
+                last = Some((t, format!("{}'s last {kind}", robot.name)));
+            }
+        }
+    }
+    last
 }

@@ -140,8 +140,9 @@ fn a_slam_run_replays_to_the_same_trajectory() {
 }
 
 /// Our file's scans and odometry re-written as another ROS 2 system would have them: topics
-/// `/scan`, `/odom` and `/truth`, stamps from a wall clock, no attachments.
-fn foreign_copy(own: &Path, robot: &str, out: &Path, with_scan: bool) {
+/// `/scan`, `/odom` and `/truth`, stamps from a wall clock, no attachments; the last odometry
+/// message stamped `odom_ahead_ns` later than it was.
+fn foreign_copy(own: &Path, robot: &str, out: &Path, with_scan: bool, odom_ahead_ns: i64) {
     let rec = McapRecording::open(own).unwrap();
     let mut w = McapRecorder::create(out, ROS2_PROFILE).unwrap();
     let epoch = 1_700_000_000_000_000_000i64;
@@ -164,11 +165,16 @@ fn foreign_copy(own: &Path, robot: &str, out: &Path, with_scan: bool) {
             msgs.push((t, Msg::Scan(m)));
         }
     }
-    for (t, mut m) in rec
+    let odom = rec
         .decode_topic::<Odometry>(&format!("/{robot}/odom"))
-        .unwrap()
-    {
+        .unwrap();
+    let n = odom.len();
+    for (i, (t, mut m)) in odom.into_iter().enumerate() {
         shift(&mut m.header);
+        if i + 1 == n {
+            let ns = m.header.stamp.as_nanos() + odom_ahead_ns;
+            m.header.stamp = crate::record::mcap::messages::Time::from_nanos(ns as u64);
+        }
         msgs.push((t, Msg::Odom(Box::new(m))));
     }
     let truth_topic = format!("/{robot}/ground_truth");
@@ -198,7 +204,7 @@ fn a_foreign_file_of_scans_and_odometry_localizes_the_chosen_robot() {
     let own = dir.path().join("own.mcap");
     live("hospital_patrol", 10.0, &own);
     let foreign = dir.path().join("foreign.mcap");
-    foreign_copy(&own, "r2", &foreign, true);
+    foreign_copy(&own, "r2", &foreign, true, 0);
     let scenario = scenario_file("hospital_patrol");
     let sc = scenario.to_str().unwrap();
     // several robots in the scenario: which one is it?
@@ -338,10 +344,22 @@ fn missing_topics_attachments_and_damage_are_clear_errors() {
 
     // a foreign file without its scans
     let no_scan = dir.path().join("no_scan.mcap");
-    foreign_copy(&own, "r1", &no_scan, false);
+    foreign_copy(&own, "r1", &no_scan, false, 0);
     let e = msg(&args(&no_scan, &["--scenario", sc, "--robot", "r1"]));
     assert!(
         e.contains("no_scan.mcap") && e.contains("no topic /scan") && e.contains("/odom"),
+        "{e}"
+    );
+    // one message stamped 10 years after the others (a stamp that fits ROS 2's 32-bit
+    // seconds): refused before the replay starts (it would run for ever), naming the reading
+    let far = dir.path().join("far.mcap");
+    let years_10 = 3650 * 86_400 * 1_000_000_000i64;
+    foreign_copy(&own, "r1", &far, true, years_10);
+    let e = msg(&args(&far, &["--scenario", sc, "--robot", "r1"]));
+    assert!(
+        e.contains("far.mcap")
+            && e.contains("r1's last odometry pose")
+            && e.contains("(3650.0 days)"),
         "{e}"
     );
     // a topic of the wrong type
