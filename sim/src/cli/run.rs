@@ -1,11 +1,13 @@
 //! `sim run`: its arguments and what it does with them.
 
 use crate::RunExports;
+use crate::batch::sets::plan_sets;
 use crate::options::check_duration;
 use crate::report::data::RunReport;
 use crate::run::report::{OutputArgs, report_run};
 use crate::run::{OutputsFailed, run_scenario_exporting};
-use crate::scenario::scenario_arg;
+use crate::scenario::source::Source;
+use crate::scenario::{scenario_arg, scenario_path};
 use std::path::PathBuf;
 
 #[derive(clap::Args, Clone, Debug)]
@@ -18,6 +20,10 @@ pub struct RunArgs {
     /// Override the scenario's duration (simulated seconds).
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
+    /// Override a scenario key, as `sim batch --set` does
+    /// (`robots.0.behaviour.speed=0.8`, `robots[name=r2].sensors.laser.rate=5`). Repeatable.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
     #[command(flatten)]
     pub out: OutputArgs,
     /// Write the event log here: scenario events and navigation events (task started,
@@ -41,7 +47,14 @@ pub struct RunArgs {
 
 /// `sim run`.
 pub fn run_command(a: &RunArgs) -> anyhow::Result<()> {
-    let mut sc = scenario_arg(a.scenario.as_deref())?;
+    let mut sc = if a.sets.is_empty() {
+        scenario_arg(a.scenario.as_deref())?
+    } else {
+        let overrides = plan_sets(&a.sets, &[], &[])?;
+        Source::load(&scenario_path(a.scenario.as_deref())?)?
+            .scenario(&overrides.sets[0])
+            .map_err(anyhow::Error::msg)?
+    };
     if let Some(s) = a.seed {
         sc.seed = s;
     }

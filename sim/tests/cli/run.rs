@@ -46,6 +46,61 @@ fn run_writes_default_rrd_and_summary_json() {
 }
 
 #[test]
+fn set_overrides_scenario_keys_and_names_a_bad_one() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
+    let run = |sets: &[&str]| {
+        let mut args = vec![
+            "run",
+            "tiny.toml",
+            "--no-rrd",
+            "--quiet",
+            "--summary",
+            "s.json",
+        ];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        let out = sim(&args, dir.path());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let s = std::fs::read_to_string(dir.path().join("s.json")).unwrap();
+        serde_json::from_str::<serde_json::Value>(&s).unwrap()
+    };
+    let plain = run(&[]);
+    let faster = run(&["robots.0.behaviour.speed=1.0", "duration=1.5"]);
+    assert!((faster["sim_time_s"].as_f64().unwrap() - 1.5).abs() < 1e-9);
+    let distance = |s: &serde_json::Value| s["robots"][0]["distance_m"].as_f64().unwrap();
+    // twice the speed for three quarters of the time: further
+    assert!(
+        distance(&faster) > 1.2 * distance(&plain),
+        "{faster} {plain}"
+    );
+    // by name, as batch keys are
+    let named = run(&["robots[name=r1].behaviour.speed=1.0", "duration=1.5"]);
+    assert_eq!(distance(&named), distance(&faster));
+    expect_failure(
+        &[
+            "run",
+            "tiny.toml",
+            "--no-rrd",
+            "--set",
+            "robots.0.sensors.laser.rate=-1",
+        ],
+        dir.path(),
+        &["robots.0.sensors.laser.rate"],
+    );
+    expect_failure(
+        &["run", "tiny.toml", "--no-rrd", "--set", "robots.0.speed"],
+        dir.path(),
+        &["--set robots.0.speed", "KEY=VALUE"],
+    );
+}
+
+#[test]
 fn no_rrd_writes_nothing_and_prints_the_table() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tiny.toml"), ROOM).unwrap();
