@@ -10,10 +10,17 @@ repo="$(cd "$here/../.." && pwd)"
 mkdir -p "$here/dicts"
 keys=$(grep -rhoE '^\s+pub [a-z_0-9]+:|rename = "[a-z_0-9]+"' "$repo/sim/src/scenario" |
     sed -E 's/^\s+pub ([a-z_0-9]+):/\1/; s/rename = "([a-z_0-9]+)"/\1/' | sort -u)
+# the format's tables, as headers on lines of their own (from the bundled scenarios and the
+# format's documentation), so mutation can add a whole section
+tables=$({
+    grep -ohE '^\[\[?[a-z_.]+\]\]?' "$repo"/assets/scenarios/*.toml "$repo/sim/docs/scenario-format.md"
+    grep -ohE '`\[\[?[a-z_.]+\]\]?`' "$repo/sim/docs/scenario-format.md" | tr -d '`'
+} | grep -v '^\[table\]$' | sort -u)
 values=(1e9 1e300 -1e300 1e-300 0.0 -0.0 -1 nan inf -inf true false 4294967296 '[]' '{}'
     '[[0.0, 0.0]]' '"waypoints"' '"go"' '"mcl"' '"wander"')
 {
     for k in $keys; do printf '"%s"\n"%s = "\n' "$k" "$k"; done
+    for t in $tables; do printf '"\\x0A%s\\x0A"\n' "$t"; done
     for v in "${values[@]}"; do printf '"%s"\n' "${v//\"/\\\"}"; done
 } >"$here/dicts/scenario.dict"
 {

@@ -71,6 +71,55 @@ to = [1.5, 0.5]
 TOML
 sed -e 's#"\.\./maps/#"assets/maps/#g' -e 's#^duration = 200.0#duration = 1.0#' \
     "$repo/assets/scenarios/maze_run.toml" >"$seeds/scenario/maze_short.toml"
+# and every behaviour and the navigation settings written out (as the bundled scenarios have
+# them, on worlds too large to run here), so that one mutation changes any of their values:
+# a looping patrol, and a robot on tasks with its planner and follower settings
+cat >"$seeds/scenario/room_patrol.toml" <<'TOML'
+duration = 2.0
+walls = [
+  { from = [0.0, 0.0], to = [6.0, 0.0] },
+  { from = [0.0, 6.0], to = [6.0, 6.0] },
+  { from = [0.0, 0.0], to = [0.0, 6.0] },
+  { from = [6.0, 0.0], to = [6.0, 6.0] },
+]
+[[robots]]
+name = "r1"
+start = [2.0, 2.0, 0.0]
+behaviour = { type = "waypoints", points = [[4.0, 2.0], [4.0, 4.0], [2.0, 4.0]], loop = true, speed = 0.5, tolerance = 0.3 }
+[robots.sensors.laser]
+[robots.sensors.encoder]
+TOML
+cat >"$seeds/scenario/room_navigation.toml" <<'TOML'
+duration = 2.0
+walls = [
+  { from = [0.0, 0.0], to = [6.0, 0.0] },
+  { from = [0.0, 6.0], to = [6.0, 6.0] },
+  { from = [0.0, 0.0], to = [0.0, 6.0] },
+  { from = [6.0, 0.0], to = [6.0, 6.0] },
+]
+boxes = [{ center = [3.0, 3.0], size = [1.0, 1.0] }]
+[[robots]]
+name = "r1"
+start = [1.0, 1.0, 0.0]
+[robots.sensors.laser]
+[robots.sensors.encoder]
+[robots.navigation]
+speed = 0.5
+max_accel = 0.5
+max_yaw_rate = 1.0
+tolerance = 0.2
+lookahead = 0.6
+safety_margin = 0.05
+inflation_radius = 0.5
+cost_weight = 1.0
+stop_distance = 0.8
+wait_time = 2.0
+priority = 1
+[[robots.tasks]]
+type = "go"
+name = "corner"
+to = [5.0, 5.0]
+TOML
 
 # overrides, one per line
 printf '%s\n' 'robots.0.sensors.laser.rate=5' 'duration=2' \
