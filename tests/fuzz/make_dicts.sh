@@ -14,6 +14,7 @@ keys=$(grep -rhoE '^\s+pub [a-z_0-9]+:|rename = "[a-z_0-9]+"' "$repo/sim/src/sce
 # format's documentation), so mutation can add a whole section
 tables=$({
     grep -ohE '^\[\[?[a-z_.]+\]\]?' "$repo"/assets/scenarios/*.toml "$repo/sim/docs/scenario-format.md"
+    # shellcheck disable=SC2016 # the backticks are the Markdown's, not a command
     grep -ohE '`\[\[?[a-z_.]+\]\]?`' "$repo/sim/docs/scenario-format.md" | tr -d '`'
 } | grep -v '^\[table\]$' | sort -u)
 values=(1e9 1e300 -1e300 1e-300 0.0 -0.0 -1 nan inf -inf true false 4294967296 '[]' '{}'
