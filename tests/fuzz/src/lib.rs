@@ -159,6 +159,112 @@ pub fn scenario(data: &[u8]) {
     }
 }
 
+/// Values at the edges of what a scenario's numbers may be: huge, tiny, zero, negative, not
+/// finite, past 32 bits.
+const EDGE_NUMBERS: [&str; 12] = [
+    "1e9",
+    "-1e9",
+    "1e-9",
+    "0",
+    "0.0",
+    "-1",
+    "1e300",
+    "-1e300",
+    "nan",
+    "inf",
+    "-inf",
+    "4294967296",
+];
+
+/// The scenario target's mutation: half the time, when the input is a TOML document, one of
+/// its values anywhere (in tables, arrays and inline tables) is replaced: a number by one at
+/// the edges ([`EDGE_NUMBERS`]) or scaled by a power of ten, a bool flipped, a string
+/// emptied. The result is still a document, so the scenario's validation and the run behind
+/// it see the value. Otherwise libFuzzer's own byte mutations run (with the dictionary).
+pub fn mutate_scenario(data: &mut [u8], size: usize, max_size: usize, seed: u32) -> usize {
+    use rand::{RngExt, SeedableRng};
+    let mut rng = rand::rngs::SmallRng::seed_from_u64(u64::from(seed));
+    if rng.random_bool(0.5)
+        && let Some(text) = mutate_one_value(&data[..size], &mut rng)
+        && text.len() <= max_size
+    {
+        data[..text.len()].copy_from_slice(text.as_bytes());
+        return text.len();
+    }
+    libfuzzer_sys::fuzzer_mutate(data, size, max_size)
+}
+
+/// `input` with one of its values changed, or None if it is not a TOML document with values.
+fn mutate_one_value(input: &[u8], rng: &mut impl rand::RngExt) -> Option<String> {
+    use toml_edit::Value;
+    let mut doc: toml_edit::DocumentMut = std::str::from_utf8(input).ok()?.parse().ok()?;
+    let mut count = 0;
+    each_value(doc.as_item_mut(), &mut |_| count += 1);
+    if count == 0 {
+        return None;
+    }
+    let chosen = rng.random_range(0..count);
+    let edge = EDGE_NUMBERS[rng.random_range(0..EDGE_NUMBERS.len())];
+    let power = rng.random_range(-6..=9);
+    let scale = rng.random_bool(0.3);
+    let mut i = 0;
+    each_value(doc.as_item_mut(), &mut |v| {
+        if i == chosen {
+            let new = match v {
+                Value::Float(f) if scale => Some(Value::from(f.value() * 10f64.powi(power))),
+                Value::Integer(n) if scale => Some(Value::from(
+                    n.value().saturating_mul(10i64.pow(power.max(0) as u32)),
+                )),
+                Value::Float(_) | Value::Integer(_) => edge.parse::<Value>().ok(),
+                Value::Boolean(b) => Some(Value::from(!b.value())),
+                Value::String(_) => Some(Value::from("")),
+                _ => None,
+            };
+            if let Some(new) = new {
+                *v = new.decorated(" ", "");
+            }
+        }
+        i += 1;
+    });
+    Some(doc.to_string())
+}
+
+/// Calls `f` on every scalar value under `item`, depth first.
+fn each_value(item: &mut toml_edit::Item, f: &mut impl FnMut(&mut toml_edit::Value)) {
+    match item {
+        toml_edit::Item::Value(v) => each_value_in(v, f),
+        toml_edit::Item::Table(t) => {
+            for (_, item) in t.iter_mut() {
+                each_value(item, f);
+            }
+        }
+        toml_edit::Item::ArrayOfTables(a) => {
+            for t in a.iter_mut() {
+                for (_, item) in t.iter_mut() {
+                    each_value(item, f);
+                }
+            }
+        }
+        toml_edit::Item::None => {}
+    }
+}
+
+fn each_value_in(v: &mut toml_edit::Value, f: &mut impl FnMut(&mut toml_edit::Value)) {
+    match v {
+        toml_edit::Value::Array(a) => {
+            for v in a.iter_mut() {
+                each_value_in(v, f);
+            }
+        }
+        toml_edit::Value::InlineTable(t) => {
+            for (_, v) in t.iter_mut() {
+                each_value_in(v, f);
+            }
+        }
+        scalar => f(scalar),
+    }
+}
+
 /// `--set KEY=VALUE` overrides, one per line, applied to a bundled-style scenario.
 pub fn overrides(data: &[u8]) {
     static SOURCE: OnceLock<sim::scenario::source::Source> = OnceLock::new();
