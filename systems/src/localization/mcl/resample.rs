@@ -130,6 +130,64 @@ pub fn low_variance_indices(w: &[f64], n: usize, u: f64) -> Vec<usize> {
     out
 }
 
+/// `s mod 1` for s ∈ [0, 2), the sum of two numbers in [0, 1): s − 1 is exact there (Sterbenz),
+/// and needs no `fmod` call.
+#[inline]
+fn unit_wrap(s: f64) -> f64 {
+    if s >= 1.0 { s - 1.0 } else { s }
+}
+
+/// The particle tooth `i` of the comb picks: the first whose cumulative weight exceeds the
+/// tooth's position ((u + vdc(i)) mod 1) · total, at most the last.
+fn comb_index(cdf: &[f64], total: f64, u: f64, i: usize) -> usize {
+    let pos = unit_wrap(u + van_der_corput(i as u32)) * total;
+    cdf.partition_point(|&c| c <= pos).min(cdf.len() - 1)
+}
+
+/// [`comb_index`] of every tooth i < n at once, by one merge of the teeth in increasing
+/// position with `cdf`; None (the caller searches tooth by tooth) unless `cdf` is finite and
+/// non-decreasing, where the merge and the binary search agree.
+///
+/// For i < n ≤ 2^m, vdc(i) = rev_m(i) / 2^m, so running k over 0..2^m and taking i = rev_m(k)
+/// visits the teeth in increasing vdc(i); u + vdc(i) rounds monotonically, and the teeth whose
+/// sum reaches 1 (a suffix of k) wrap below the others.
+fn comb_indices(cdf: &[f64], total: f64, u: f64, n: usize) -> Option<Vec<u32>> {
+    let len = cdf.len();
+    if len == 0 || len > u32::MAX as usize || n > 1 << 31 {
+        return None;
+    }
+    if !(cdf.iter().all(|c| c.is_finite()) && cdf.windows(2).all(|p| p[0] <= p[1])) {
+        return None;
+    }
+    let m = n.max(1).next_power_of_two().trailing_zeros();
+    let tooth = |k: u32| -> u32 {
+        if m == 0 {
+            0
+        } else {
+            k.reverse_bits() >> (32 - m)
+        }
+    };
+    let size = 1u32 << m;
+    // the first k whose sum u + vdc reaches 1: those from it on come first once wrapped
+    let wraps = (0..size)
+        .find(|&k| u + van_der_corput(tooth(k)) >= 1.0)
+        .unwrap_or(size);
+    let mut out = vec![0u32; n];
+    let mut j = 0;
+    for k in (wraps..size).chain(0..wraps) {
+        let i = tooth(k) as usize;
+        if i >= n {
+            continue;
+        }
+        let pos = unit_wrap(u + van_der_corput(i as u32)) * total;
+        while j < len && cdf[j] <= pos {
+            j += 1;
+        }
+        out[i] = j.min(len - 1) as u32;
+    }
+    Some(out)
+}
+
 /// How many particles to draw.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CountLimits {
@@ -176,13 +234,21 @@ pub fn resample(
     let mut occupied = FxHashSet::default();
     let max = limits.max.max(1);
     let min = limits.min.clamp(1, max);
+    // every tooth's particle in one merge when the draw will likely take most of the teeth (the
+    // cloud was large), else a binary search per tooth drawn: the same indices either way
+    let merged = (n_old.saturating_mul(4) >= max)
+        .then(|| comb_indices(&cdf, total, u, max))
+        .flatten();
+    let mut bound = (0, 1);
     for i in 0..max {
         let (x, y, th) = if p_inject > 0.0 && rng.random::<f64>() < p_inject {
             let mut uniform = || rng.random::<f64>();
             random_pose(&mut uniform)
         } else {
-            let pos = ((u + van_der_corput(i as u32)) % 1.0) * total;
-            let j = cdf.partition_point(|&c| c <= pos).min(n_old - 1);
+            let j = match &merged {
+                Some(m) => m[i] as usize,
+                None => comb_index(&cdf, total, u, i),
+            };
             (xs[j], ys[j], ths[j])
         };
         nx.push(x);
@@ -190,8 +256,14 @@ pub fn resample(
         nt.push(th);
         if limits.kld {
             occupied.insert(bins.key(x, y, th));
+            if bound.0 != occupied.len() {
+                bound = (
+                    occupied.len(),
+                    kld_bound(occupied.len(), limits.epsilon, limits.z),
+                );
+            }
             let count = i + 1;
-            if count >= min && count >= kld_bound(occupied.len(), limits.epsilon, limits.z) {
+            if count >= min && count >= bound.1 {
                 break;
             }
         }
@@ -222,6 +294,64 @@ mod tests {
             assert!(idx.windows(2).all(|p| p[0] <= p[1]));
         }
         assert!(low_variance_indices(&[], 4, 0.5).is_empty());
+    }
+
+    /// The one-merge draw picks, for every tooth, the particle the binary search picks: over
+    /// weights with runs of zeros, counts that are and are not powers of two, and offsets at
+    /// both ends of [0, 1), where the teeth wrap.
+    #[test]
+    fn merged_comb_picks_what_the_search_picks() {
+        let mut rng = stream_rng(7, "t", "comb");
+        for len in [1usize, 2, 7, 100, 5000] {
+            let w: Vec<f64> = (0..len)
+                .map(|k| {
+                    if k % 5 == 3 {
+                        0.0
+                    } else {
+                        rng.random::<f64>().powi(4)
+                    }
+                })
+                .collect();
+            let cdf: Vec<f64> = w
+                .iter()
+                .scan(0.0, |acc, wi| {
+                    *acc += wi;
+                    Some(*acc)
+                })
+                .collect();
+            let total = cdf[len - 1].max(f64::MIN_POSITIVE);
+            for n in [1usize, 2, 3, 64, 1000, 4096, 5000, 5001] {
+                for u in [
+                    0.0,
+                    1e-300,
+                    0.25,
+                    0.5,
+                    0.999_999,
+                    1.0 - f64::EPSILON / 2.0,
+                    rng.random(),
+                ] {
+                    let merged = comb_indices(&cdf, total, u, n).expect("a finite cdf");
+                    for (i, &j) in merged.iter().enumerate() {
+                        assert_eq!(
+                            j as usize,
+                            comb_index(&cdf, total, u, i),
+                            "len {len} n {n} u {u} i {i}"
+                        );
+                    }
+                }
+            }
+        }
+        // the wrap is `% 1.0` to the bit over [0, 2)
+        for _ in 0..100_000 {
+            let x = rng.random::<f64>() + rng.random::<f64>();
+            assert_eq!(unit_wrap(x).to_bits(), (x % 1.0).to_bits(), "{x}");
+        }
+        for x in [0.0, 1.0, 1.0 - f64::EPSILON / 2.0, 2.0 - f64::EPSILON] {
+            assert_eq!(unit_wrap(x).to_bits(), (x % 1.0).to_bits(), "{x}");
+        }
+        // a cdf that is not non-decreasing is left to the search
+        assert!(comb_indices(&[1.0, f64::NAN, 2.0], 2.0, 0.5, 4).is_none());
+        assert!(comb_indices(&[], 1.0, 0.5, 4).is_none());
     }
 
     #[test]
