@@ -23,12 +23,13 @@ pub struct FedRun {
 }
 
 /// Runs `est` over `scans` on `pool`; `after(k, record, scan, est)` is called after each update
-/// (recording, progress) and is not counted in the update times.
+/// (recording, progress) and is not counted in the update times. The whole loop runs inside one
+/// section of the pool, so the caller's thread hands over to the pool once, not once per scan.
 pub fn feed_scans(
     est: &mut dyn ScanEstimator,
     scans: &[&ScanRecord],
     pool: &KernelPool,
-    mut after: impl FnMut(usize, &ScanRecord, &LaserScan, &dyn ScanEstimator),
+    mut after: impl FnMut(usize, &ScanRecord, &LaserScan, &dyn ScanEstimator) + Send,
 ) -> FedRun {
     let started = Instant::now();
     let mut run = FedRun {
@@ -36,20 +37,22 @@ pub fn feed_scans(
         update_ms: Vec::with_capacity(scans.len()),
         ..FedRun::default()
     };
-    for (k, s) in scans.iter().enumerate() {
-        let scan = s.to_laser_scan();
-        let t = Instant::now();
-        let published = pool.install(|| est.update(&scan, &s.mount, &s.robot_pose));
-        run.update_ms.push(t.elapsed().as_secs_f64() * 1e3);
-        if published && let Some(e) = est.estimate() {
-            run.online.push((s.timestamp, e.pose));
+    pool.install(|| {
+        for (k, s) in scans.iter().enumerate() {
+            let scan = s.to_laser_scan();
+            let t = Instant::now();
+            let published = est.update(&scan, &s.mount, &s.robot_pose);
+            run.update_ms.push(t.elapsed().as_secs_f64() * 1e3);
+            if published && let Some(e) = est.estimate() {
+                run.online.push((s.timestamp, e.pose));
+            }
+            after(k, s, &scan, &*est);
         }
-        after(k, s, &scan, &*est);
-    }
-    // a smoother's final optimization is part of the run
-    let t = Instant::now();
-    pool.install(|| est.finish());
-    run.finish_ms = t.elapsed().as_secs_f64() * 1e3;
+        // a smoother's final optimization is part of the run
+        let t = Instant::now();
+        est.finish();
+        run.finish_ms = t.elapsed().as_secs_f64() * 1e3;
+    });
     run.wall_time_s = started.elapsed().as_secs_f64();
     run.trajectory = est.trajectory();
     run

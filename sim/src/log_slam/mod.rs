@@ -150,7 +150,8 @@ fn write_tum(path: &Path, poses: impl Iterator<Item = (f64, Pose2)>) -> anyhow::
         .map_err(|e| anyhow::anyhow!("{}: cannot write the trajectory: {e}", path.display()))
 }
 
-/// `sim slam`: runs, prints the report (unless quiet), writes the files asked for.
+/// `sim slam`: runs, prints the report (unless quiet), writes the files asked for. A quiet run
+/// with no summary and no saved map returns a report without the map's size.
 pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     let log = read_carmen(&a.carmen, &read_options(a)?)?;
     let file = a.carmen.display().to_string();
@@ -219,7 +220,11 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     }
     let (online, trajectory) = (run.online, run.trajectory);
     let odometry: Vec<(f64, Pose2)> = scans.iter().map(|s| (s.timestamp, s.robot_pose)).collect();
-    let map = est.map();
+    // the whole map is built only for what reads it: the printed report, the summary's map
+    // size and the saved map (for graph SLAM, every node's scan inserted again)
+    let map = (!a.quiet || a.summary.is_some() || a.save_map.is_some())
+        .then(|| est.map())
+        .flatten();
     let mut report = SlamReport {
         log: file.clone(),
         robot: robot.clone(),

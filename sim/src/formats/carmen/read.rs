@@ -67,11 +67,28 @@ pub fn read_carmen(path: &Path, opts: &CarmenReadOptions) -> Result<CarmenLog, C
     parse_carmen(&String::from_utf8_lossy(&bytes), &file, opts)
 }
 
-/// Parses the text of a CARMEN log; `name` is the file name errors give.
+/// Parses the text of a CARMEN log; `name` is the file name errors give. Lines are parsed on
+/// their own (a large log in parallel, in contiguous runs of lines) and applied in order, so the
+/// log and the first error are the same as line by line.
 pub fn parse_carmen(
     text: &str,
     name: &str,
     opts: &CarmenReadOptions,
+) -> Result<CarmenLog, CarmenError> {
+    let threads = if text.len() < PARALLEL_BYTES {
+        1
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get().min(MAX_PARSE_THREADS))
+    };
+    parse_on(text, name, opts, threads)
+}
+
+/// [`parse_carmen`] on `threads` threads.
+fn parse_on(
+    text: &str,
+    name: &str,
+    opts: &CarmenReadOptions,
+    threads: usize,
 ) -> Result<CarmenLog, CarmenError> {
     check_options("front", &opts.front)?;
     check_options("rear", &opts.rear)?;
@@ -82,53 +99,135 @@ pub fn parse_carmen(
         old_front: Vec::new(),
         old_rear: Vec::new(),
     };
-    for (i, raw) in text.lines().enumerate() {
-        let mut toks = raw.split_whitespace();
-        let Some(kind) = toks.next() else { continue };
-        if kind.starts_with('#') {
-            continue;
-        }
-        let line = i + 1;
-        let fields = |message, format| Fields {
-            file: name,
-            line,
-            message,
-            format,
-            toks: toks.clone().collect(),
-            pos: 0,
-        };
-        match kind {
-            "PARAM" => p.param(fields("PARAM", PARAM_FORMAT))?,
-            "ODOM" => {
-                let r = odom(fields("ODOM", ODOM_FORMAT))?;
-                p.log.odometry.push(r);
+    let lines: Vec<&str> = text.lines().collect();
+    let items = parse_lines(&lines, name, threads);
+    for item in items {
+        match item? {
+            Line::Blank => {}
+            Line::Param(line) => {
+                let raw = lines[line - 1];
+                let mut toks = raw.split_whitespace();
+                toks.next();
+                p.param(Fields {
+                    file: name,
+                    line,
+                    message: "PARAM",
+                    format: PARAM_FORMAT,
+                    toks: toks.collect(),
+                    pos: 0,
+                })?;
             }
-            "TRUEPOS" => {
-                let r = truepos(fields("TRUEPOS", TRUEPOS_FORMAT))?;
-                p.log.truth.push(r);
-            }
-            "FLASER" => {
-                let s = old_laser(fields("FLASER", FLASER_FORMAT), ScanSource::Flaser)?;
-                p.old_front.push(s);
-            }
-            "RLASER" => {
-                let s = old_laser(fields("RLASER", RLASER_FORMAT), ScanSource::Rlaser)?;
-                p.old_rear.push(s);
-            }
-            "ROBOTLASER1" => {
-                let f = fields("ROBOTLASER1", ROBOTLASER1_FORMAT);
-                p.log.scans.push(robot_laser(f, ScanSource::RobotLaser1)?);
-            }
-            "ROBOTLASER2" => {
-                let f = fields("ROBOTLASER2", ROBOTLASER2_FORMAT);
-                p.log
-                    .rear_scans
-                    .push(robot_laser(f, ScanSource::RobotLaser2)?);
-            }
-            other => *p.log.skipped.entry(other.to_string()).or_default() += 1,
+            Line::Odom(r) => p.log.odometry.push(r),
+            Line::Truth(r) => p.log.truth.push(r),
+            Line::OldFront(s) => p.old_front.push(s),
+            Line::OldRear(s) => p.old_rear.push(s),
+            Line::Front(s) => p.log.scans.push(s),
+            Line::Rear(s) => p.log.rear_scans.push(s),
+            Line::Skipped(kind) => *p.log.skipped.entry(kind.to_string()).or_default() += 1,
         }
     }
     Ok(p.finish(opts))
+}
+
+/// Logs from this size on are parsed on several threads.
+const PARALLEL_BYTES: usize = 1 << 20;
+const MAX_PARSE_THREADS: usize = 8;
+
+/// One line, parsed on its own. PARAM lines change the reader's state, so they are only
+/// noted here (by line number) and read in order.
+enum Line<'a> {
+    Blank,
+    Param(usize),
+    Odom(OdomRecord),
+    Truth(TruePosRecord),
+    OldFront(ScanRecord),
+    OldRear(ScanRecord),
+    Front(ScanRecord),
+    Rear(ScanRecord),
+    Skipped(&'a str),
+}
+
+/// Every line parsed, in order, in `threads` contiguous runs.
+fn parse_lines<'a>(
+    lines: &[&'a str],
+    name: &str,
+    threads: usize,
+) -> Vec<Result<Line<'a>, CarmenError>> {
+    if threads <= 1 {
+        return lines
+            .iter()
+            .enumerate()
+            .map(|(i, raw)| parse_line(i + 1, raw, name))
+            .collect();
+    }
+    let run = lines.len().div_ceil(threads).max(1);
+    let parts: Option<Vec<Vec<_>>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = lines
+            .chunks(run)
+            .enumerate()
+            .map(|(k, chunk)| {
+                std::thread::Builder::new()
+                    .spawn_scoped(scope, move || {
+                        chunk
+                            .iter()
+                            .enumerate()
+                            .map(|(i, raw)| parse_line(k * run + i + 1, raw, name))
+                            .collect::<Vec<_>>()
+                    })
+                    .ok()
+            })
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.and_then(|h| h.join().ok()))
+            .collect()
+    });
+    match parts {
+        Some(parts) => parts.into_iter().flatten().collect(),
+        // a thread that could not start (parsing itself does not panic): all on this one
+        None => parse_lines(lines, name, 1),
+    }
+}
+
+/// Line `line` (1-based) of the log.
+fn parse_line<'a>(line: usize, raw: &'a str, name: &str) -> Result<Line<'a>, CarmenError> {
+    let mut toks = raw.split_whitespace();
+    let Some(kind) = toks.next() else {
+        return Ok(Line::Blank);
+    };
+    if kind.starts_with('#') {
+        return Ok(Line::Blank);
+    }
+    let fields = |message, format| Fields {
+        file: name,
+        line,
+        message,
+        format,
+        toks: toks.clone().collect(),
+        pos: 0,
+    };
+    Ok(match kind {
+        "PARAM" => Line::Param(line),
+        "ODOM" => Line::Odom(odom(fields("ODOM", ODOM_FORMAT))?),
+        "TRUEPOS" => Line::Truth(truepos(fields("TRUEPOS", TRUEPOS_FORMAT))?),
+        "FLASER" => Line::OldFront(old_laser(
+            fields("FLASER", FLASER_FORMAT),
+            ScanSource::Flaser,
+        )?),
+        "RLASER" => Line::OldRear(old_laser(
+            fields("RLASER", RLASER_FORMAT),
+            ScanSource::Rlaser,
+        )?),
+        "ROBOTLASER1" => Line::Front(robot_laser(
+            fields("ROBOTLASER1", ROBOTLASER1_FORMAT),
+            ScanSource::RobotLaser1,
+        )?),
+        "ROBOTLASER2" => Line::Rear(robot_laser(
+            fields("ROBOTLASER2", ROBOTLASER2_FORMAT),
+            ScanSource::RobotLaser2,
+        )?),
+        other => Line::Skipped(other),
+    })
 }
 
 fn check_options(side: &str, o: &OldLaserOverrides) -> Result<(), CarmenError> {

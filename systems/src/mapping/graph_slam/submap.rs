@@ -128,10 +128,25 @@ impl Submaps {
             self.all.push(Submap::new(node, *local, map));
             self.active.push(self.all.len() - 1);
         }
-        for &i in &self.active {
-            let s = &mut self.all[i];
-            s.map.insert(sensor, scan);
-            s.nodes.push(node);
+        match self.active[..] {
+            // the two active submaps share nothing: they take the scan side by side on the pool
+            [a, b] if a < b => {
+                let (older, newer) = self.all.split_at_mut(b);
+                let (older, newer) = (&mut older[a], &mut newer[0]);
+                rayon::join(
+                    || older.map.insert(sensor, scan),
+                    || newer.map.insert(sensor, scan),
+                );
+                older.nodes.push(node);
+                newer.nodes.push(node);
+            }
+            _ => {
+                for &i in &self.active {
+                    let s = &mut self.all[i];
+                    s.map.insert(sensor, scan);
+                    s.nodes.push(node);
+                }
+            }
         }
         let mut finished = Vec::new();
         while let Some(&i) = self.active.first() {

@@ -332,3 +332,50 @@ fn file_errors_name_the_file() {
     let e = read_carmen(&gz, &opts).unwrap_err();
     assert!(e.to_string().contains("intel.clf.gz") && e.to_string().contains("gunzip"));
 }
+
+/// A log of a few MB is parsed in parallel runs of lines: the log is the one a line-by-line
+/// read gives (PARAMs anywhere applied in order), and of two malformed lines in different runs
+/// the error names the first.
+#[test]
+fn a_large_log_parses_in_parallel_as_line_by_line() {
+    let beams = |k: usize| {
+        (0..181)
+            .map(|b| format!("{:.3}", 1.0 + ((k * 7 + b) % 50) as f64 * 0.1))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut lines = vec!["PARAM laser_front_laser_fov 180".to_string()];
+    for k in 0..3000 {
+        let t = k as f64 * 0.1;
+        lines.push(format!("ODOM {t} 0 0 0 0 0 {t} h {t}"));
+        lines.push(format!("FLASER 181 {} {t} 0 0 {t} 0 0 {t} h {t}", beams(k)));
+        lines.push(format!("TRUEPOS {t} 0 0 {t} 0 0 {t} h {t}"));
+        if k == 1500 {
+            // a PARAM half-way changes every old line's geometry, as it did line by line
+            lines.push("PARAM robot_front_laser_max 30".into());
+            lines.push("NAVIGATOR something else".into());
+        }
+    }
+    let text = lines.join("\n");
+    assert!(text.len() > 2 << 20, "{} bytes", text.len());
+    let opts = CarmenReadOptions::default();
+    let parallel = super::parse_on(&text, "t.log", &opts, 3).unwrap();
+    assert_eq!(parallel, super::parse_on(&text, "t.log", &opts, 1).unwrap());
+    assert_eq!(parallel, parse(&text).unwrap());
+    assert_eq!(parallel.scans.len(), 3000);
+    assert_eq!(parallel.odometry.len(), 3000);
+    assert_eq!(parallel.truth.len(), 3000);
+    assert_eq!(parallel.skipped.get("NAVIGATOR"), Some(&1));
+    assert_eq!(parallel.scans[2999].max_range, 30.0);
+    assert!(parallel.scans.iter().all(|s| close(s.fov, PI)));
+    // errors: the first of two, whichever thread found it
+    let mut bad = lines.clone();
+    bad[6000] = "ODOM 1 2 x 0 0 0 1 h 1".into();
+    bad[8000] = "TRUEPOS 1 2".into();
+    for threads in [1, 2, 3, 8] {
+        let e = super::parse_on(&bad.join("\n"), "t.log", &opts, threads)
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("t.log:6001: ODOM"), "{threads}: {e}");
+    }
+}
