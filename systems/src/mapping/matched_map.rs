@@ -46,11 +46,19 @@ impl MatchedMap {
     /// Inserts `scan` taken from `sensor` (the laser's pose in the map frame) and brings the
     /// mirror and the pyramid up to date.
     pub fn insert(&mut self, sensor: &Pose2, scan: &LaserScan) {
-        let before = (self.map.width(), self.map.height(), self.map.origin());
+        let before = (
+            self.map.width(),
+            self.map.height(),
+            self.map.lattice_cell0(),
+        );
         let stats = self.map.insert_scan(sensor, scan);
         self.scans += 1;
-        let after = (self.map.width(), self.map.height(), self.map.origin());
-        if before != after || self.pyramid.is_none() {
+        let after = (
+            self.map.width(),
+            self.map.height(),
+            self.map.lattice_cell0(),
+        );
+        if (before != after && !self.carry_over(before)) || self.pyramid.is_none() {
             self.prob = self.map.to_prob_grid();
             self.pyramid = Some(MapPyramid::with_options(
                 &self.prob,
@@ -76,6 +84,45 @@ impl MatchedMap {
         if let Some(p) = &mut self.pyramid {
             p.update_region(&self.prob, c0, r0, c1, r1);
         }
+    }
+
+    /// After the map grew (it was `width` × `height` from lattice cell `cell0`): the mirror and
+    /// the pyramid moved into the grown grid, the new cells unknown (log-odds 0, as the map's
+    /// new cells are before the scan); the scan's own cells, new or old, are then updated as
+    /// after any scan. False, for a full rebuild, when there is nothing to move or the pyramid
+    /// cannot be carried over.
+    fn carry_over(&mut self, (width, height, cell0): (usize, usize, [i64; 2])) -> bool {
+        let Some(pyramid) = &self.pyramid else {
+            return false;
+        };
+        let now = self.map.lattice_cell0();
+        let (dx, dy) = (cell0[0] - now[0], cell0[1] - now[1]);
+        if width == 0 || height == 0 || dx < 0 || dy < 0 {
+            return false;
+        }
+        let (dx, dy) = (dx as usize, dy as usize);
+        let (nw, nh) = (self.map.width(), self.map.height());
+        if dx + width > nw || dy + height > nh || self.prob.width != width {
+            return false;
+        }
+        let mut p = vec![probability(0.0); nw * nh];
+        for r in 0..height {
+            let dst = (r + dy) * nw + dx;
+            p[dst..dst + width].copy_from_slice(&self.prob.p[r * width..(r + 1) * width]);
+        }
+        let prob = ProbGrid {
+            width: nw,
+            height: nh,
+            resolution: self.map.resolution(),
+            origin: self.map.origin(),
+            p,
+        };
+        let Some(grown) = pyramid.grown(&prob, [dx, dy]) else {
+            return false;
+        };
+        self.prob = prob;
+        self.pyramid = Some(grown);
+        true
     }
 
     /// The pyramid matchers read; None before the first scan is inserted.
@@ -146,6 +193,43 @@ mod tests {
             }
         });
         assert!(m.scans > 50, "{} scans", m.scans);
+        assert_mirror_exact(&m);
+    }
+
+    /// The mirror and the pyramid carried over when the map grows (copied into place, the new
+    /// cells computed) equal those built from scratch after every scan, to the bit: growth on
+    /// every side, by drives along the corridor both ways.
+    #[test]
+    fn a_grown_map_carries_its_mirror_and_pyramid_over_exactly() {
+        let map = hospital();
+        let mut back = CORRIDOR;
+        back.reverse();
+        // east and north, then from the far end west and south: growth on every side
+        for (route, heading) in [(CORRIDOR, 0.0), (back, std::f64::consts::PI)] {
+            let mut m = MatchedMap::new(0.05, OccupancyParams::slam(), 4);
+            let (mut step, mut grown) = (0, 0);
+            drive(&map, &route, heading, 5, |truth, _, scan| {
+                step += 1;
+                if step % 4 != 0 {
+                    return;
+                }
+                let before = (m.log_odds().width(), m.log_odds().height());
+                m.insert(truth, scan);
+                if (m.log_odds().width(), m.log_odds().height()) != before {
+                    grown += 1;
+                }
+                assert_mirror_exact(&m);
+                let plain = MapPyramid::with_options(&m.prob, 4, PyramidOptions::slam_map());
+                assert!(
+                    m.pyramid() == Some(&plain),
+                    "pyramid differs after scan {step}"
+                );
+            });
+            assert!(grown >= 3, "the map grew {grown} times");
+        }
+    }
+
+    fn assert_mirror_exact(m: &MatchedMap) {
         let plain = m.log_odds().to_prob_grid();
         assert_eq!(
             (m.prob().width, m.prob().height),

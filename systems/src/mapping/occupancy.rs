@@ -122,6 +122,12 @@ impl LogOddsMap {
     pub fn origin(&self) -> [f64; 2] {
         self.extent.origin()
     }
+
+    /// The lattice index of cell (0, 0): a grown map's old cells lie at the difference of the
+    /// old and new values (whole cells, no rounding).
+    pub(crate) fn lattice_cell0(&self) -> [i64; 2] {
+        self.extent.cell0
+    }
     /// The log-odds of every cell, `row * width + col`.
     pub fn log_odds(&self) -> &[f32] {
         &self.cells

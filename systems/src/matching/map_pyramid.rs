@@ -59,6 +59,13 @@ impl MapPyramid {
 
     /// `levels` (at least 1) levels built as `options` say.
     pub fn with_options(grid: &ProbGrid, levels: usize, options: PyramidOptions) -> Self {
+        let mut p = Self::empty(grid, levels, options);
+        p.rebuild(grid);
+        p
+    }
+
+    /// The levels for `grid`, every value 0.
+    fn empty(grid: &ProbGrid, levels: usize, options: PyramidOptions) -> Self {
         let mut out = Vec::with_capacity(levels.max(1));
         let (mut w, mut h, mut res, mut origin) =
             (grid.width, grid.height, grid.resolution, grid.origin);
@@ -81,13 +88,56 @@ impl MapPyramid {
                 raw: if keep_raw { vec![0.0; w * h] } else { vec![] },
             });
         }
-        let mut p = MapPyramid {
+        MapPyramid {
             levels: out,
             options,
             grid_size: [grid.width, grid.height],
-        };
-        p.rebuild(grid);
-        p
+        }
+    }
+
+    /// This pyramid carried over to `grid`, the grid it was built from grown by whole cells
+    /// with the old cell (0, 0) now at `at`: every level is copied into place and what depends
+    /// on the new cells is recomputed, so the result equals [`MapPyramid::with_options`] on
+    /// `grid` wherever the old part of `grid` holds what it held (the caller then updates the
+    /// window of its own changes, as after any change). None, for a full build, where the
+    /// copy would not land on whole cells of every level (`at` not a multiple of 2^(levels−1))
+    /// or with surfaces on faces (level 0 on cell corners).
+    pub fn grown(&self, grid: &ProbGrid, at: [usize; 2]) -> Option<MapPyramid> {
+        let [ow, oh] = self.grid_size;
+        let top = 1usize << (self.levels.len() - 1);
+        let fits = at[0] + ow <= grid.width && at[1] + oh <= grid.height;
+        if self.options.surfaces != Surfaces::InCells || !fits || at[0] % top + at[1] % top != 0 {
+            return None;
+        }
+        let mut p = Self::empty(grid, self.levels.len(), self.options);
+        for (k, (old, new)) in self.levels.iter().zip(&mut p.levels).enumerate() {
+            let (x, y) = (at[0] >> k, at[1] >> k);
+            if x + old.width > new.width || y + old.height > new.height {
+                return None;
+            }
+            for (from, to) in [(&old.m, &mut new.m), (&old.raw, &mut new.raw)] {
+                if from.is_empty() {
+                    continue;
+                }
+                for r in 0..old.height {
+                    let dst = (r + y) * new.width + x;
+                    to[dst..dst + old.width]
+                        .copy_from_slice(&from[r * old.width..(r + 1) * old.width]);
+                }
+            }
+        }
+        // the new cells: the strips left and right of the old part, then below and above it
+        let (x0, y0, x1, y1) = (at[0], at[1], at[0] + ow, at[1] + oh);
+        let strips = [
+            [0, 0, x0, grid.height],
+            [x1, 0, grid.width, grid.height],
+            [x0, 0, x1, y0],
+            [x0, y1, x1, grid.height],
+        ];
+        for [c0, r0, c1, r1] in strips {
+            p.update_region(grid, c0, r0, c1, r1);
+        }
+        Some(p)
     }
 
     pub fn levels(&self) -> usize {
