@@ -312,7 +312,21 @@ pub fn dominant_cluster(
     w: &[f64],
     bins: &BinSize,
 ) -> Option<PoseEstimate> {
-    dominant_cluster_with(xs, ys, ths, w, bins, true)
+    dominant_cluster_with(xs, ys, ths, &[], w, bins, true)
+}
+
+/// [`dominant_cluster`] with the headings' sines and cosines taken from `trig` where its
+/// entry holds the particle's heading to the bit (`[θ, sin θ, cos θ]`, as the weighing keeps
+/// them), computed otherwise: the same estimate.
+pub fn dominant_cluster_with_trig(
+    xs: &[f64],
+    ys: &[f64],
+    ths: &[f64],
+    trig: &[[f64; 3]],
+    w: &[f64],
+    bins: &BinSize,
+) -> Option<PoseEstimate> {
+    dominant_cluster_with(xs, ys, ths, trig, w, bins, true)
 }
 
 /// [`dominant_cluster`] as first written: bins and all 26 neighbours looked up in a hash map,
@@ -325,13 +339,14 @@ pub fn dominant_cluster_plain(
     w: &[f64],
     bins: &BinSize,
 ) -> Option<PoseEstimate> {
-    dominant_cluster_with(xs, ys, ths, w, bins, false)
+    dominant_cluster_with(xs, ys, ths, &[], w, bins, false)
 }
 
 fn dominant_cluster_with(
     xs: &[f64],
     ys: &[f64],
     ths: &[f64],
+    trig: &[[f64; 3]],
     w: &[f64],
     bins: &BinSize,
     fast: bool,
@@ -376,8 +391,12 @@ fn dominant_cluster_with(
             sw += w[i];
             mx += w[i] * xs[i];
             my += w[i] * ys[i];
-            sc += w[i] * ths[i].cos();
-            ss += w[i] * ths[i].sin();
+            let (s, c) = match trig.get(i) {
+                Some(&[th, s, c]) if th.to_bits() == ths[i].to_bits() => (s, c),
+                _ => ths[i].sin_cos(),
+            };
+            sc += w[i] * c;
+            ss += w[i] * s;
         }
     }
     if sw <= 0.0 {
@@ -427,6 +446,52 @@ mod tests {
         assert!((e.pose.theta.abs() - pi).abs() < 1e-9, "{}", e.pose.theta);
         assert!((e.weight - 0.8).abs() < 1e-9);
         assert!(e.covariance[0][0] > 0.0 && e.covariance[2][2] < 1e-3);
+    }
+
+    /// Sines and cosines kept from the weighing give the estimate computed without them, to
+    /// the bit; an entry whose heading is not the particle's (resampled away, injected, moved)
+    /// is not used.
+    #[test]
+    fn kept_sines_and_cosines_give_the_same_estimate() {
+        use crate::core::SimRng;
+        use rand::{RngExt, SeedableRng};
+        let mut rng = SimRng::seed_from_u64(11);
+        let n = 5000;
+        let xs: Vec<f64> = (0..n).map(|_| 3.0 + rng.random_range(-0.3..0.3)).collect();
+        let ys: Vec<f64> = (0..n).map(|_| 7.0 + rng.random_range(-0.3..0.3)).collect();
+        let ths: Vec<f64> = (0..n).map(|_| 0.4 + rng.random_range(-0.3..0.3)).collect();
+        let w: Vec<f64> = (0..n).map(|_| rng.random::<f64>()).collect();
+        let trig: Vec<[f64; 3]> = ths
+            .iter()
+            .enumerate()
+            .map(|(i, &th)| match i % 3 {
+                0 => {
+                    let (s, c) = th.sin_cos();
+                    [th, s, c]
+                }
+                // another particle's heading and values, and a stale mark
+                1 => [th + 1e-12, 0.5, 0.5],
+                _ => [f64::NAN; 3],
+            })
+            .collect();
+        let bins = BinSize::default();
+        let plain = dominant_cluster(&xs, &ys, &ths, &w, &bins).unwrap();
+        for kept in [&trig[..], &trig[..n / 2], &[]] {
+            let e = dominant_cluster_with_trig(&xs, &ys, &ths, kept, &w, &bins).unwrap();
+            assert_eq!(e.pose.theta.to_bits(), plain.pose.theta.to_bits());
+            assert_eq!(e, plain);
+        }
+        // separate sin and cos calls, as the cluster made them before, give the same sums
+        let (mut sc, mut ss) = (0.0f64, 0.0f64);
+        let (mut sc2, mut ss2) = (0.0f64, 0.0f64);
+        for i in 0..n {
+            sc += w[i] * ths[i].cos();
+            ss += w[i] * ths[i].sin();
+            let (s, c) = ths[i].sin_cos();
+            sc2 += w[i] * c;
+            ss2 += w[i] * s;
+        }
+        assert_eq!((sc.to_bits(), ss.to_bits()), (sc2.to_bits(), ss2.to_bits()));
     }
 
     /// The dense histogram and the sets joined by size find the same clusters, roots and
@@ -516,8 +581,8 @@ mod tests {
             );
             let clusters = roots.iter().enumerate().filter(|&(i, &r)| i == r).count();
             assert!(clusters >= 1, "case {n}");
-            let a = dominant_cluster_with(&xs, &ys, &ths, &w, &bins, true).unwrap();
-            let b = dominant_cluster_with(&xs, &ys, &ths, &w, &bins, false).unwrap();
+            let a = dominant_cluster_with(&xs, &ys, &ths, &[], &w, &bins, true).unwrap();
+            let b = dominant_cluster_with(&xs, &ys, &ths, &[], &w, &bins, false).unwrap();
             assert_eq!(format!("{a:?}"), format!("{b:?}"), "case {n}");
         }
     }

@@ -29,8 +29,13 @@ pub struct GridPose {
 
 impl GridPose {
     pub fn new(field: &DistanceField, x: f64, y: f64, theta: f64) -> Self {
-        let inv = 1.0 / field.resolution;
         let (s, c) = theta.sin_cos();
+        Self::with_sin_cos(field, x, y, s, c)
+    }
+
+    /// [`GridPose::new`] from the heading's sine `s` and cosine `c`, already computed.
+    pub fn with_sin_cos(field: &DistanceField, x: f64, y: f64, s: f64, c: f64) -> Self {
+        let inv = 1.0 / field.resolution;
         GridPose {
             gx: ((x - field.origin[0]) * inv) as f32 + 1.0,
             gy: ((y - field.origin[1]) * inv) as f32 + 1.0,

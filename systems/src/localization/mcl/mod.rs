@@ -178,6 +178,10 @@ pub struct Mcl {
     pub ths: Vec<f64>,
     /// Normalised weights.
     pub w: Vec<f64>,
+    /// `[θ, sin θ, cos θ]` per particle as the last likelihood-field weighing computed them,
+    /// carried through resampling: the cluster reuses an entry whose θ is the particle's to
+    /// the bit (empty when the beam model weighed).
+    trig: Vec<[f64; 3]>,
     rng: SimRng,
     w_slow: f64,
     w_fast: f64,
@@ -223,6 +227,7 @@ impl Mcl {
             ys,
             ths,
             w: vec![1.0 / n as f64; n],
+            trig: Vec::new(),
             rng,
             w_slow: 0.0,
             w_fast: 0.0,
@@ -245,7 +250,14 @@ impl Mcl {
     }
 
     fn cluster(&self) -> Option<PoseEstimate> {
-        cluster::dominant_cluster(&self.xs, &self.ys, &self.ths, &self.w, &self.config.bins)
+        cluster::dominant_cluster_with_trig(
+            &self.xs,
+            &self.ys,
+            &self.ths,
+            &self.trig,
+            &self.w,
+            &self.config.bins,
+        )
     }
 
     /// Computes the estimate of the particles as they are now, if nobody has asked for it
@@ -297,14 +309,14 @@ impl Mcl {
             LaserModel::LikelihoodField => {
                 let table = self.field_table(map, beams.range_max);
                 let points = beams.returns();
-                sensor_model::weigh_likelihood_field(
+                self.trig.resize(self.ths.len(), [f64::NAN; 3]);
+                sensor_model::weigh_likelihood_field_keeping_trig(
                     &map.field,
                     &table,
                     &points,
-                    &self.xs,
-                    &self.ys,
-                    &self.ths,
+                    [&self.xs, &self.ys, &self.ths],
                     &mut self.w,
+                    &mut self.trig,
                 );
             }
             LaserModel::Beam => sensor_model::weigh_beam_model(
@@ -499,6 +511,7 @@ impl Mcl {
             &mut self.xs,
             &mut self.ys,
             &mut self.ths,
+            &mut self.trig,
             &mut self.w,
             &limits,
             &self.config.bins,

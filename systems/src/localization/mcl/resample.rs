@@ -201,12 +201,15 @@ pub struct CountLimits {
 }
 
 /// Resamples (xs, ys, ths) with normalised weights `w` into new arrays (weights reset to 1/n).
-/// `random_pose` draws an injected particle; `p_inject` is the injection probability.
+/// `random_pose` draws an injected particle; `p_inject` is the injection probability. `trig`,
+/// the weighing's `[θ, sin θ, cos θ]` per particle, follows the particles when it has one
+/// entry per particle (an injected particle's entry is marked stale), else it is emptied.
 #[allow(clippy::too_many_arguments)]
 pub fn resample(
     xs: &mut Vec<f64>,
     ys: &mut Vec<f64>,
     ths: &mut Vec<f64>,
+    trig: &mut Vec<[f64; 3]>,
     w: &mut Vec<f64>,
     limits: &CountLimits,
     bins: &BinSize,
@@ -240,15 +243,23 @@ pub fn resample(
         .then(|| comb_indices(&cdf, total, u, max))
         .flatten();
     let mut bound = (0, 1);
+    let follow = trig.len() == n_old;
+    let mut new_trig = Vec::with_capacity(if follow { limits.max } else { 0 });
     for i in 0..max {
         let (x, y, th) = if p_inject > 0.0 && rng.random::<f64>() < p_inject {
             let mut uniform = || rng.random::<f64>();
+            if follow {
+                new_trig.push([f64::NAN; 3]);
+            }
             random_pose(&mut uniform)
         } else {
             let j = match &merged {
                 Some(m) => m[i] as usize,
                 None => comb_index(&cdf, total, u, i),
             };
+            if follow {
+                new_trig.push(trig[j]);
+            }
             (xs[j], ys[j], ths[j])
         };
         nx.push(x);
@@ -269,6 +280,7 @@ pub fn resample(
         }
     }
     let n = nx.len();
+    *trig = new_trig;
     *xs = nx;
     *ys = ny;
     *ths = nt;
@@ -389,6 +401,7 @@ mod tests {
             &mut xs,
             &mut ys,
             &mut ths,
+            &mut Vec::new(),
             &mut w,
             &limits,
             &BinSize::default(),
@@ -424,6 +437,7 @@ mod tests {
             &mut xs,
             &mut ys,
             &mut ths,
+            &mut Vec::new(),
             &mut w,
             &limits,
             &BinSize::default(),
@@ -437,6 +451,7 @@ mod tests {
             &mut xs,
             &mut ys,
             &mut ths,
+            &mut Vec::new(),
             &mut w,
             &limits,
             &BinSize::default(),

@@ -156,18 +156,59 @@ pub fn weigh_likelihood_field(
     ths: &[f64],
     w: &mut [f64],
 ) {
+    weigh_field(field, table, points, [xs, ys, ths], w, None);
+}
+
+/// [`weigh_likelihood_field`] that also keeps, per particle, its heading with the sine and
+/// cosine the weighing computed of it (`trig`, one entry per particle), for the cluster to
+/// reuse.
+pub fn weigh_likelihood_field_keeping_trig(
+    field: &DistanceField,
+    table: &[f32; 256],
+    points: &[[f32; 2]],
+    [xs, ys, ths]: [&[f64]; 3],
+    w: &mut [f64],
+    trig: &mut [[f64; 3]],
+) {
+    weigh_field(field, table, points, [xs, ys, ths], w, Some(trig));
+}
+
+fn weigh_field(
+    field: &DistanceField,
+    table: &[f32; 256],
+    points: &[[f32; 2]],
+    [xs, ys, ths]: [&[f64]; 3],
+    w: &mut [f64],
+    trig: Option<&mut [[f64; 3]]>,
+) {
     let far = table[crate::world::distance_field::FAR as usize];
-    w.par_chunks_mut(CHUNK).enumerate().for_each(|(c, wc)| {
-        let base = c * CHUNK;
+    let weigh = |base: usize, wc: &mut [f64], mut tc: Option<&mut [[f64; 3]]>| {
         let poses: Vec<GridPose> = (base..base + wc.len())
-            .map(|i| GridPose::new(field, xs[i], ys[i], ths[i]))
+            .map(|i| {
+                let (s, c) = ths[i].sin_cos();
+                if let Some(t) = tc.as_deref_mut() {
+                    t[i - base] = [ths[i], s, c];
+                }
+                GridPose::with_sin_cos(field, xs[i], ys[i], s, c)
+            })
             .collect();
         let mut p = vec![0.0f32; wc.len()];
         field_kernel::score_all(field, table, far, points, &poses, &mut p);
         for (wi, p) in wc.iter_mut().zip(p) {
             *wi *= p as f64;
         }
-    });
+    };
+    match trig {
+        Some(t) if t.len() == w.len() => w
+            .par_chunks_mut(CHUNK)
+            .zip(t.par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (wc, tc))| weigh(c * CHUNK, wc, Some(tc))),
+        _ => w
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(c, wc)| weigh(c * CHUNK, wc, None)),
+    }
 }
 
 /// Beam-model kernel: multiplies `w[i]` by 1 + Σ pz³, the expected ranges ray-cast on `rays`
