@@ -128,10 +128,8 @@ printf '%s\n' 'robots[0].start=[0.5, 0.5, 0.0]' 'map.places="places.toml"' \
     'robots.0.behaviour={ type = "wander", speed = 0.3 }' >"$seeds/overrides/tables.txt"
 
 # maps: YAML, a line ---, the image
-for m in maze; do
-    { cat "$repo/assets/maps/$m/$m.yaml"; printf '\n---\n'; cat "$repo/assets/maps/$m/$m.pgm"; } \
-        >"$seeds/map/$m"
-done
+{ cat "$repo/assets/maps/maze/maze.yaml"; printf '\n---\n'; cat "$repo/assets/maps/maze/maze.pgm"; } \
+    >"$seeds/map/maze"
 { printf 'image: map.pgm\nresolution: 0.1\norigin: [-1.0, -2.0, 0.5]\nnegate: 1\nmode: scale\n'
   printf '\n---\n'; printf 'P5\n4 3\n255\n'; printf '\x00\x40\x80\xff%.0s' 1 2 3; } \
     >"$seeds/map/tiny"

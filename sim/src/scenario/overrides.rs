@@ -39,12 +39,17 @@ fn bare_key(k: &str) -> bool {
 pub const MAX_KEY_PARTS: usize = 32;
 
 /// Parses a key path: keys separated by dots, array items as `.N`, `[N]` or `[key=value]`.
-pub fn parse_path(flag: &str, key: &str) -> anyhow::Result<Vec<Step>> {
-    let shown: String = if key.chars().count() > 80 {
-        key.chars().take(60).chain("…".chars()).collect()
+/// A key or value as messages show it: whole up to 80 characters, else its first 60 and `…`.
+fn shorten(text: &str) -> String {
+    if text.chars().count() > 80 {
+        text.chars().take(60).chain("…".chars()).collect()
     } else {
-        key.to_string()
-    };
+        text.to_string()
+    }
+}
+
+pub fn parse_path(flag: &str, key: &str) -> anyhow::Result<Vec<Step>> {
+    let shown = shorten(key);
     let bad = |why: &str| {
         anyhow::anyhow!(
             "{flag} {shown}: {why} (expected keys separated by dots, array items as .N, [N] or \
@@ -125,9 +130,15 @@ impl Override {
         matches!(self.path.as_slice(), [Step::Key(k)] if k == "seed")
     }
 
-    /// How it was given: `--sweep key=value`.
+    /// How it was given: `--sweep key=value` (a key or value of over 80 characters
+    /// shortened).
     pub fn describe(&self) -> String {
-        format!("{} {}={}", self.flag, self.key, self.text)
+        format!(
+            "{} {}={}",
+            self.flag,
+            shorten(&self.key),
+            shorten(&self.text)
+        )
     }
 
     /// Sets the value in `doc`; returns the path with every array item as its index

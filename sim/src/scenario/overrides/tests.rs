@@ -152,6 +152,19 @@ fn structural_errors() {
     }
 }
 
+/// A value of kilobytes is shown shortened in the error, which still names the key.
+#[test]
+fn a_long_value_is_shortened_in_messages() {
+    let long = "x".repeat(5000);
+    let e = set("robots.5.name", &long).unwrap_err().to_string();
+    assert!(e.starts_with("--set robots.5.name=xxxx"), "{e}");
+    assert!(e.contains("…: `robots` has 2 items"), "{e}");
+    assert!(e.len() < 300, "{} bytes: {e}", e.len());
+    // short ones stay whole
+    let o = Override::new("--set", "duration", "12").unwrap();
+    assert_eq!(o.describe(), "--set duration=12");
+}
+
 #[test]
 fn the_top_level_seed_is_told_apart() {
     let o = |k: &str| Override::new("--set", k, "1").unwrap();
