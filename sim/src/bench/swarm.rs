@@ -33,9 +33,11 @@ pub struct SwarmOptions {
     /// Beams per scan.
     #[arg(long, value_delimiter = ',', num_args = 1.., default_values_t = [180usize, 1081])]
     pub beams: Vec<usize>,
-    /// Simulated seconds per configuration.
-    #[arg(long, default_value_t = 10.0, allow_negative_numbers = true)]
-    pub duration: f64,
+    /// Simulated seconds per configuration (default: 4000 s divided by the robot count, at
+    /// least 10 s, a tenth of that with `--mcl`: about a second of wall time for every
+    /// population, where 10 s of one robot take a few milliseconds, too short to time).
+    #[arg(long, allow_negative_numbers = true)]
+    pub duration: Option<f64>,
     /// Worker threads (0 = one per core; at most 1024).
     #[arg(long, default_value_t = 0, value_parser = crate::options::parse_threads)]
     pub threads: usize,
@@ -316,8 +318,22 @@ impl SwarmMaps {
     }
 }
 
+/// Simulated seconds for `robots` robots: `--duration`, else the default of [`SwarmOptions`].
+fn duration_for(o: &SwarmOptions, robots: usize) -> f64 {
+    default_duration(o.duration, o.mcl.is_some(), robots)
+}
+
+fn default_duration(given: Option<f64>, mcl: bool, robots: usize) -> f64 {
+    given.unwrap_or_else(|| {
+        let total = if mcl { 400.0 } else { 4000.0 };
+        (total / robots.max(1) as f64).max(10.0)
+    })
+}
+
 pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
-    check_duration(o.duration)?;
+    if let Some(d) = o.duration {
+        check_duration(d)?;
+    }
     if let Some(n) = o.robots.iter().find(|n| **n == 0) {
         anyhow::bail!("--robots: expected populations of at least 1 robot, got {n}");
     }
@@ -336,14 +352,14 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
     // they run, one copy of the hospital must hold its share
     let mut placed: Vec<Option<Scenario>> = match per_hospital {
         Some(per) => {
-            swarm_scenario(&maps.hospital, per, 180, o.duration)
+            swarm_scenario(&maps.hospital, per, 180, duration_for(o, per))
                 .map_err(|e| anyhow::anyhow!("--per-hospital {per}: {e}"))?;
             runs.iter().map(|_| None).collect()
         }
         None => {
             let (grid, _) = maps.for_robots(0);
             runs.iter()
-                .map(|&(beams, n)| swarm_scenario(&grid, n, beams, o.duration).map(Some))
+                .map(|&(beams, n)| swarm_scenario(&grid, n, beams, duration_for(o, n)).map(Some))
                 .collect::<anyhow::Result<_>>()?
         }
     };
@@ -376,7 +392,7 @@ pub fn run_swarm_bench(o: &SwarmOptions) -> anyhow::Result<()> {
         let (grid, map) = maps.for_robots(n);
         let mut sc = match placed[k].take() {
             Some(sc) => sc,
-            None => swarm_scenario(&grid, n, beams, o.duration)?,
+            None => swarm_scenario(&grid, n, beams, duration_for(o, n))?,
         };
         drop(grid);
         if let Some(d) = o.mcl {
@@ -467,6 +483,19 @@ mod tests {
             }
         }
         g
+    }
+
+    /// Without `--duration`, small populations run long enough to time (4000 robot-seconds,
+    /// a tenth with MCL) and large ones at least 10 s; a given duration is kept.
+    #[test]
+    fn the_default_duration_follows_the_population() {
+        assert_eq!(default_duration(None, false, 1), 4000.0);
+        assert_eq!(default_duration(None, false, 10), 400.0);
+        assert_eq!(default_duration(None, false, 1000), 10.0);
+        assert_eq!(default_duration(None, true, 1), 400.0);
+        assert_eq!(default_duration(None, true, 100), 10.0);
+        assert_eq!(default_duration(Some(0.3), false, 1), 0.3);
+        assert_eq!(default_duration(Some(7.0), true, 5000), 7.0);
     }
 
     #[test]
