@@ -3,6 +3,8 @@
 //! [cell0, cell0 + size), so growing never moves a cell in the world, and the origin is always
 //! `anchor + cell0 · resolution` (an exact integer multiple, no accumulated rounding).
 
+use crate::world::grid::place_rows;
+
 /// Where a grid lies on its lattice.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Extent {
@@ -83,12 +85,8 @@ pub(crate) fn grow_to<A: Copy + Default, B: Copy + Default>(
     let mut nb = vec![B::default(); nw * nh];
     // old rows land at column offset −nc0, row offset −nr0
     let (dx, dy) = ((-nc0) as usize, (-nr0) as usize);
-    for row in 0..extent.height {
-        let src = row * extent.width..(row + 1) * extent.width;
-        let dst = (row + dy) * nw + dx;
-        na[dst..dst + extent.width].copy_from_slice(&a[src.clone()]);
-        nb[dst..dst + extent.width].copy_from_slice(&b[src]);
-    }
+    place_rows(a, extent.width, &mut na, nw, [dx, dy]);
+    place_rows(b, extent.width, &mut nb, nw, [dx, dy]);
     let grown = Extent {
         resolution: extent.resolution,
         anchor: extent.anchor,

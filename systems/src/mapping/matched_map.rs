@@ -11,6 +11,7 @@ use crate::matching::ProbGrid;
 use crate::matching::gauss_newton::{GaussNewtonParams, GnResult, OdometryPrior, match_scan};
 use crate::matching::map_pyramid::{MapPyramid, PyramidOptions};
 use crate::sensors::LaserScan;
+use crate::world::grid::place_rows;
 
 #[derive(Clone, Debug)]
 pub struct MatchedMap {
@@ -106,10 +107,7 @@ impl MatchedMap {
             return false;
         }
         let mut p = vec![probability(0.0); nw * nh];
-        for r in 0..height {
-            let dst = (r + dy) * nw + dx;
-            p[dst..dst + width].copy_from_slice(&self.prob.p[r * width..(r + 1) * width]);
-        }
+        place_rows(&self.prob.p, width, &mut p, nw, [dx, dy]);
         let prob = ProbGrid {
             width: nw,
             height: nh,

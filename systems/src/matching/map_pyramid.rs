@@ -35,6 +35,7 @@
 pub use level::{Combine, MapSample, PyramidLevel, PyramidOptions, Surfaces};
 
 use super::ProbGrid;
+use crate::world::grid::place_rows;
 use build::{combine_level, corner_values};
 use level::Window;
 
@@ -119,11 +120,7 @@ impl MapPyramid {
                 if from.is_empty() {
                     continue;
                 }
-                for r in 0..old.height {
-                    let dst = (r + y) * new.width + x;
-                    to[dst..dst + old.width]
-                        .copy_from_slice(&from[r * old.width..(r + 1) * old.width]);
-                }
+                place_rows(from, old.width, to, new.width, [x, y]);
             }
         }
         // the new cells: the strips left and right of the old part, then below and above it

@@ -151,8 +151,39 @@ impl OccupancyGrid {
     }
 }
 
+/// Copies the row-major `src`, `width` cells wide, into the row-major `dst`, `dst_width` cells
+/// wide, with `src`'s cell (0, 0) landing on `dst`'s cell `at`: how a grid grown by whole cells
+/// keeps its old cells where they were. `src`'s rows must fit inside `dst`.
+pub fn place_rows<T: Copy>(
+    src: &[T],
+    width: usize,
+    dst: &mut [T],
+    dst_width: usize,
+    at: [usize; 2],
+) {
+    if width == 0 {
+        return;
+    }
+    for (r, row) in src.chunks_exact(width).enumerate() {
+        let start = (r + at[1]) * dst_width + at[0];
+        dst[start..start + width].copy_from_slice(row);
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::place_rows;
+
+    #[test]
+    fn placed_rows_keep_their_cells_and_leave_the_rest() {
+        // a 3 × 2 block into a 5 × 4 grid at column 1, row 2
+        let src = [1, 2, 3, 4, 5, 6];
+        let mut dst = [0; 20];
+        place_rows(&src, 3, &mut dst, 5, [1, 2]);
+        assert_eq!(dst[10..20], [0, 1, 2, 3, 0, 0, 4, 5, 6, 0]);
+        assert!(dst[..10].iter().all(|&v| v == 0));
+    }
+
     use super::*;
 
     #[test]
