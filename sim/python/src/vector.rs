@@ -7,7 +7,8 @@
 //! Episode k of world i runs with seed `seed + i + k·N` (modulo 2⁶⁴): the first episodes are seeds
 //! `seed … seed + N − 1`, and no two episodes share a seed. Each world runs its kernels on the
 //! thread that steps it, so world i with seed s follows the trajectory of a single
-//! `Simulation` with seed s, whatever N and the thread count.
+//! `Simulation` with seed s, whatever N and the thread count. That thread is the same at every
+//! call (`KernelPool::for_each_pinned`), so a world's state stays in its core's caches.
 
 use crate::convert::array;
 use crate::errors::{SimError, scenario_error};
@@ -262,12 +263,20 @@ impl PyVecSimulation {
                     .cache(cache.clone()),
             );
         }
-        let built: Vec<anyhow::Result<Simulation>> = py.detach(|| {
-            use rayon::prelude::*;
-            pool.install(|| builders.into_par_iter().map(|b| b.build()).collect())
+        // each world is built by the worker that will step it (see `step`)
+        type Built = Option<anyhow::Result<Simulation>>;
+        let mut built: Vec<(Option<sim::SimulationBuilder>, Built)> =
+            builders.into_iter().map(|b| (Some(b), None)).collect();
+        py.detach(|| {
+            pool.for_each_pinned(&mut built, |(todo, done)| {
+                *done = todo.take().map(|b| b.build());
+            })
         });
         let mut slots = Vec::with_capacity(num_worlds);
-        for (i, b) in built.into_iter().enumerate() {
+        for (i, (_, b)) in built.into_iter().enumerate() {
+            let Some(b) = b else {
+                return Err(SimError::new_err(format!("world {i} was not built")));
+            };
             let sim = b.map_err(scenario_error)?;
             slots.push(Slot {
                 sim,
@@ -308,33 +317,26 @@ impl PyVecSimulation {
         let base = seed.unwrap_or(worlds.seed);
         worlds.seed = base;
         let (robots, beams) = (&self.robots, self.beams.iter().copied().max().unwrap_or(0));
-        let slots = &mut worlds.slots;
-        let outs: Vec<Out> = py.detach(|| {
-            use rayon::prelude::*;
-            self.pool.install(|| {
-                slots
-                    .par_iter_mut()
-                    .enumerate()
-                    .map(|(i, slot)| {
-                        let mut out = Out {
-                            reset: true,
-                            ..Out::default()
-                        };
-                        slot.episode = 0;
-                        slot.seed = base.wrapping_add(i as u64);
-                        slot.ended = false;
-                        let r =
-                            restart(&mut slot.sim, slot.seed, self.reset_ticks).and_then(|()| {
-                                observe(&slot.sim, robots, beams, &mut out).map_err(Into::into)
-                            });
-                        if let Err(e) = r {
-                            out.error = Some(format!("{e:#}"));
-                        }
-                        out
-                    })
-                    .collect()
+        let mut jobs: Vec<(u64, &mut Slot, Out)> = worlds
+            .slots
+            .iter_mut()
+            .enumerate()
+            .map(|(i, slot)| (i as u64, slot, Out::default()))
+            .collect();
+        py.detach(|| {
+            self.pool.for_each_pinned(&mut jobs, |(i, slot, out)| {
+                out.reset = true;
+                slot.episode = 0;
+                slot.seed = base.wrapping_add(*i);
+                slot.ended = false;
+                let r = restart(&mut slot.sim, slot.seed, self.reset_ticks)
+                    .and_then(|()| observe(&slot.sim, robots, beams, out).map_err(Into::into));
+                if let Err(e) = r {
+                    out.error = Some(format!("{e:#}"));
+                }
             })
         });
+        let outs: Vec<Out> = jobs.into_iter().map(|(_, _, out)| out).collect();
         let seeds = worlds.slots.iter().map(|s| s.seed).collect();
         self.stack(py, outs, seeds)
     }
@@ -405,18 +407,15 @@ impl PyVecSimulation {
             })
             .collect();
         py.detach(|| {
-            use rayon::prelude::*;
-            self.pool.install(|| {
-                jobs.par_iter_mut().for_each(|job| {
-                    run_job(
-                        job,
-                        n as u64,
-                        base,
-                        [ticks, self.reset_ticks],
-                        robots,
-                        beams,
-                    )
-                })
+            self.pool.for_each_pinned(&mut jobs, |job| {
+                run_job(
+                    job,
+                    n as u64,
+                    base,
+                    [ticks, self.reset_ticks],
+                    robots,
+                    beams,
+                )
             })
         });
         let outs: Vec<Out> = jobs.into_iter().map(|j| j.out).collect();

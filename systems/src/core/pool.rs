@@ -8,8 +8,8 @@
 //! (sim/docs/benchmarks.md, "Swarm").
 
 use bevy_ecs::prelude::Resource;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The most workers a pool may have: far more than any machine's cores (results do not depend
@@ -195,6 +195,44 @@ impl KernelPool {
         }
     }
 
+    /// Runs `f` on every item, each worker taking first the items of its own share: of `n`
+    /// items over `t` workers, worker `w` owns items `w·n/t .. (w+1)·n/t`, the same ones at
+    /// every call, so an item whose state is large (a whole world of a vectorized simulation)
+    /// finds it in the caches of the core that last ran it, and in the allocator's arena of the
+    /// thread that made it. A worker done with its share takes what is left of the others', so
+    /// one slow item does not hold the rest. Results are the same as a loop over the items.
+    pub fn for_each_pinned<T: Send>(&self, items: &mut [T], f: impl Fn(&mut T) + Send + Sync) {
+        let threads = self.threads();
+        let Some(pool) = self
+            .pool
+            .as_ref()
+            .filter(|p| threads > 1 && items.len() > 1 && p.current_thread_index().is_none())
+        else {
+            return self.install(|| items.iter_mut().for_each(f));
+        };
+        let n = items.len();
+        let start = |w: usize| w * n / threads;
+        let cursors: Vec<AtomicUsize> = (0..threads).map(|w| AtomicUsize::new(start(w))).collect();
+        // each item is taken by one worker only (the cursors hand every index out once), so its
+        // lock is never contended; it makes the shared slice's items reachable from every worker
+        let cells: Vec<Mutex<&mut T>> = items.iter_mut().map(Mutex::new).collect();
+        self.section.fetch_add(1, Ordering::AcqRel);
+        pool.broadcast(|ctx| {
+            for k in 0..threads {
+                let w = (ctx.index() + k) % threads;
+                loop {
+                    let i = cursors[w].fetch_add(1, Ordering::Relaxed);
+                    if i >= start(w + 1) {
+                        break;
+                    }
+                    let mut item = cells[i].lock().unwrap_or_else(|e| e.into_inner());
+                    f(&mut item);
+                }
+            }
+        });
+        self.stay_awake();
+    }
+
     /// [`KernelPool::for_each_init`] without scratch.
     pub fn for_each<T: Send>(&self, items: &mut [T], f: impl Fn(&mut T) + Send + Sync) {
         self.for_each_init(items, || (), |_, item| f(item));
@@ -268,6 +306,41 @@ mod tests {
             let mut expected: Vec<usize> = [0, 1, 2, 7, 100].iter().flat_map(|&n| 0..n).collect();
             expected.sort_unstable();
             assert_eq!(seen, expected);
+        }
+    }
+
+    /// Every item once, whatever the count, the threads and how slow some items are; each
+    /// worker starts with its own share, the same items at every call.
+    #[test]
+    fn pinned_items_are_each_run_once_and_stay_on_their_worker() {
+        for threads in [1, 2, 3] {
+            let pool = KernelPool::new(threads).unwrap();
+            for n in [0, 1, 2, 5, 64] {
+                let mut items: Vec<(usize, u32)> = (0..n).map(|i| (i, 0)).collect();
+                pool.for_each_pinned(&mut items, |(i, runs)| {
+                    *runs += 1;
+                    if *i == 0 {
+                        // one slow item: the other workers take over the rest of its share
+                        std::thread::sleep(Duration::from_millis(5));
+                    }
+                });
+                assert!(items.iter().all(|&(_, runs)| runs == 1), "{items:?}");
+            }
+        }
+        // the first item of each share waits until both workers have started theirs, so
+        // neither can finish its share early and take the other's: item 0 runs on worker 0,
+        // item 4 on worker 1, at every call
+        let pool = KernelPool::new(2).unwrap();
+        let both = std::sync::Barrier::new(2);
+        for _ in 0..3 {
+            let mut items: Vec<(usize, Option<usize>)> = (0..8).map(|i| (i, None)).collect();
+            pool.for_each_pinned(&mut items, |(i, worker)| {
+                if *i % 4 == 0 {
+                    both.wait();
+                }
+                *worker = rayon::current_thread_index();
+            });
+            assert_eq!((items[0].1, items[4].1), (Some(0), Some(1)), "{items:?}");
         }
     }
 
