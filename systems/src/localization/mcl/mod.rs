@@ -10,7 +10,9 @@
 //!   resampling) or when random particles are due; low-variance, KLD-adaptive count between a
 //!   minimum and a maximum ([`resample`]);
 //! - random-particle injection from short- and long-term averages of the measurement likelihood
-//!   (Augmented MCL), so a kidnapped robot is found again;
+//!   (Augmented MCL), so a kidnapped robot is found again; injected particles, and a share of
+//!   the particles at every update while a globally started filter has not settled, are drawn
+//!   from poses that explain the scan (the dual proposal of Mixture MCL, [`injection`]);
 //! - global initialisation uniformly over free space, or a Gaussian around a given pose;
 //! - estimate: weighted mean and covariance of the dominant cluster ([`cluster`]).
 
@@ -86,7 +88,9 @@ pub struct MclConfig {
     /// pose explains the scan `challenge_ratio` times better than the filter's best particle,
     /// `challenge_fraction` of the particles are drawn from the proposal at the next
     /// resampling. A filter that converged to a look-alike place is pulled out of it this way:
-    /// the weight averages cannot see a wrong place that fits the scans almost as well.
+    /// the weight averages cannot see a wrong place that fits the scans almost as well. A
+    /// filter started globally draws from the proposal at every update until it settles (the
+    /// dual proposal of Mixture MCL, poses explaining the scan at least as well as its own).
     pub challenge_every: u64,
     pub challenge_ratio: f64,
     pub challenge_fraction: f64,
@@ -371,15 +375,15 @@ impl Mcl {
         (!pool.is_empty()).then_some(pool)
     }
 
-    /// The poses among `candidates` that explain the scan at least `challenge_ratio` times
-    /// better than the filter's best explanation of it (the best of its heaviest particles),
-    /// best first.
+    /// The poses among `candidates` that explain the scan at least `ratio` times as well as
+    /// the filter's best explanation of it (the best of its heaviest particles), best first.
     fn better_than_filter(
         &self,
         map: &LocalizationMap,
         table: &[f32; 256],
         points: &[[f32; 2]],
         candidates: &[(f64, f64, f64)],
+        ratio: f64,
     ) -> Vec<(f64, f64, f64)> {
         let mut top: Vec<usize> = (0..self.len()).collect();
         let k = CHALLENGE_TOP.min(top.len());
@@ -404,7 +408,7 @@ impl Mcl {
         let mut score = vec![1.0f64; xs.len()];
         sensor_model::weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
         let own = score[m..].iter().copied().fold(f64::MIN_POSITIVE, f64::max);
-        let bar = own * self.config.challenge_ratio;
+        let bar = own * ratio;
         let mut better: Vec<(f64, (f64, f64, f64))> = candidates
             .iter()
             .zip(&score[..m])
@@ -454,7 +458,8 @@ impl Mcl {
                     (p.x, p.y, p.theta)
                 })
                 .collect();
-            let better = self.better_than_filter(map, &table, &points, &moved);
+            let ratio = self.config.challenge_ratio;
+            let better = self.better_than_filter(map, &table, &points, &moved, ratio);
             if better.is_empty() {
                 return None; // the filter explains this scan as well: dropped
             }
@@ -467,7 +472,8 @@ impl Mcl {
             self.contender = Some(c);
             return None;
         }
-        if self.updates % every != every - 1 {
+        let searching = self.searching();
+        if !searching && self.updates % every != every - 1 {
             return None;
         }
         let pool = injection::scan_proposal(
@@ -479,7 +485,16 @@ impl Mcl {
             n,
             &mut self.rng,
         );
-        let mut better = self.better_than_filter(map, &table, &points, &pool);
+        if searching {
+            // Mixture MCL's dual proposal [Thrun 2001, §4], at every update: poses drawn from
+            // the scan, weighed by a belief that is still about uniform over the places. Among
+            // look-alike places the true one gets particles again at every update, whatever
+            // the cloud's first draws held, until the scans tell the places apart.
+            let drawn = self.better_than_filter(map, &table, &points, &pool, 1.0);
+            return (!drawn.is_empty()).then_some(drawn);
+        }
+        let ratio = self.config.challenge_ratio;
+        let mut better = self.better_than_filter(map, &table, &points, &pool, ratio);
         if !better.is_empty() && self.wins_needed() <= 1 {
             return Some(better);
         }
@@ -492,6 +507,14 @@ impl Mcl {
             });
         }
         None
+    }
+
+    /// Whether the filter is still searching the floor: started globally and not yet settled on
+    /// a place (its dominant cluster spreads over [`SETTLED_SPREAD_M`]). A filter started
+    /// around a known pose is not: its belief is far from uniform over the places the scan
+    /// proposal finds, and drawing from them pulled its estimate along a corridor.
+    fn searching(&self) -> bool {
+        self.config.init == InitialBelief::Global && self.wins_needed() <= 1
     }
 
     fn resample(
@@ -610,6 +633,7 @@ impl MapLocalizer for Mcl {
         }
         self.updates += 1;
         self.estimate = OnceLock::from(self.cluster());
+
         true
     }
 
