@@ -633,7 +633,6 @@ impl MapLocalizer for Mcl {
         }
         self.updates += 1;
         self.estimate = OnceLock::from(self.cluster());
-
         true
     }
 
