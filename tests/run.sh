@@ -59,6 +59,12 @@ echo "building and installing the Python package into a fresh virtual environmen
 # array of 4 shards (tests/slurm/shard.sbatch); the merged shards must equal the batch run whole.
 SIM_BIN="${CARGO_TARGET_DIR:-target}/release/sim" tests/slurm/run.sh
 
+# sim built without its .rrd recording (no `rrd` feature), as the fuzz crate below builds it:
+# a run asked for a .rrd is refused by name (the one test, which must run)
+cargo test -p sim --no-default-features --lib -- --exact \
+    run::simulation::tests::builder::a_build_without_the_recording_refuses_a_rrd_by_name |
+    tee /dev/stderr | grep "test result: ok. 1 passed" >/dev/null
+
 # Fuzzing (tests/fuzz, cargo fuzz on the stable toolchain): each reader of user files runs its
 # seeds and every input that once failed, then 15 s of coverage-guided mutations. The long run
 # is `tests/fuzz/run.sh 600` (sim/docs/reliability.md).

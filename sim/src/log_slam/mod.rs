@@ -22,6 +22,7 @@ use crate::build::new_scan_estimator;
 use crate::formats::carmen::{CarmenReadOptions, OldLaserOverrides, read_carmen};
 use crate::formats::maps::{MapToSave, save_maps};
 use crate::formats::tum::tum_line;
+#[cfg(feature = "rrd")]
 use crate::record::rrd::log_slam::ReplayRecorder;
 use crate::scenario::slam_file::resolve_slam_config;
 use eval::TruthTrack;
@@ -185,6 +186,7 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("{robot}-slam.rrd")))
     });
+    #[cfg(feature = "rrd")]
     let mut rec = match &rrd {
         Some(p) => Some(ReplayRecorder::create(
             p,
@@ -194,6 +196,10 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
         )?),
         None => None,
     };
+    #[cfg(not(feature = "rrd"))]
+    if let Some(p) = &rrd {
+        return Err(crate::record::without_rrd(p));
+    }
     if !a.quiet {
         eprintln!(
             "running {} ({}) on {file}: {} scans over {:.1} s",
@@ -205,6 +211,9 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     }
     let bar = progress(a.quiet, scans.len());
     let run = feed_scans(est.as_mut(), &scans, &pool, |k, s, scan, est| {
+        #[cfg(not(feature = "rrd"))]
+        let _ = (s, scan, est); // no recording in this build
+        #[cfg(feature = "rrd")]
         if let Some(r) = rec.as_mut() {
             let at = (s.timestamp, &s.robot_pose, truth.at(s.timestamp), &s.mount);
             r.scan(est, scan, at);
@@ -215,6 +224,7 @@ pub fn run_slam_command(a: &SlamArgs) -> anyhow::Result<SlamReport> {
     });
     bar.finish_and_clear();
     let wall_time_s = run.wall_time_s;
+    #[cfg(feature = "rrd")]
     if let Some(r) = rec {
         r.finish(est.as_ref(), t1)?;
     }

@@ -13,7 +13,9 @@
 //! the worker's speed. The messages of an MCAP file are therefore not in log-time order (a frame
 //! follows a few seconds of other messages); readers order them by their log time.
 
+#[cfg(feature = "rrd")]
 use super::rrd::RrdRecorder;
+#[cfg(feature = "rrd")]
 use super::rrd::events::record_events;
 use bevy_ecs::prelude::*;
 use std::cell::Cell;
@@ -211,16 +213,18 @@ impl SimPlugin for FramesPlugin {
         let jpeg = frames.outputs.jpeg;
         world.insert_resource(frames);
         let collect = collect_frames.in_set(SimSet::Record);
+        // the .rrd's images after the frames are collected and after the .rrd's other
+        // recorders (all write the recorder); JPEGs are made only for a .rrd
+        #[cfg(feature = "rrd")]
         if jpeg {
-            // the .rrd's images after the frames are collected and after the .rrd's other
-            // recorders (all write the recorder)
             let images = record_frames_rrd
                 .in_set(SimSet::Record)
                 .after(record_events);
             schedule.add_systems((collect, images).chain());
-        } else {
-            schedule.add_systems(collect);
+            return;
         }
+        debug_assert!(!jpeg, "JPEG frames without a .rrd to take them");
+        schedule.add_systems(collect);
     }
 }
 
@@ -319,6 +323,7 @@ pub fn collect_frames(
 
 /// Logs `frames` to the .rrd at `robots/<name>/camera` (taking their JPEGs), each at its own
 /// time; the recording's time is `now` afterwards.
+#[cfg(feature = "rrd")]
 pub fn log_frames_rrd(r: &mut RrdRecorder, frames: &mut [RecordedFrame], now: f64) {
     for f in frames {
         let Some(jpeg) = f.jpeg.take() else { continue };
@@ -341,6 +346,7 @@ pub fn log_frames_rrd(r: &mut RrdRecorder, frames: &mut [RecordedFrame], now: f6
 }
 
 /// Record set, after [`collect_frames`]: the .rrd's camera images.
+#[cfg(feature = "rrd")]
 pub fn record_frames_rrd(
     clock: Res<SimClock>,
     mut frames: ResMut<RecordedFrames>,

@@ -5,7 +5,7 @@
 //! [`MAP_CELLS`] cells along its longer side: a report of a long run stays a few hundred kB.
 
 use crate::formats::tum::RobotLocalization;
-use crate::record::rrd::path_trace::PathTrace;
+use crate::record::path_trace::PathTrace;
 use crate::run::RunOutput;
 use crate::scenario::Scenario;
 use serde::{Deserialize, Serialize};

@@ -4,8 +4,8 @@
 //! ([`crate::record::colours`]).
 
 use super::data::{MapCells, Outcome, RoadLine, RobotTrace};
+use crate::record::axis_scale::AxisScale;
 use crate::record::colours;
-use crate::record::rrd::blueprint::AxisScale;
 use plotters::prelude::*;
 
 /// Width of every figure (px).

@@ -6,15 +6,19 @@
 use crate::build::SimWorld;
 use crate::formats::carmen::export::{CarmenExport, CarmenExportPlugin};
 use crate::formats::maps::{KnownPoseMapsPlugin, can_map};
-use crate::record::frames::{FrameOutputs, FramesPlugin, RecordedFrames, log_frames_rrd};
+#[cfg(feature = "rrd")]
+use crate::record::frames::log_frames_rrd;
+use crate::record::frames::{FrameOutputs, FramesPlugin, RecordedFrames};
+#[cfg(feature = "rrd")]
 use crate::record::rrd::slam::record_slam_final;
+#[cfg(feature = "rrd")]
 use crate::record::rrd::{RrdPlugin, RrdRecorder};
 use crate::record::topics::{McapExport, McapPlugin};
 use crate::run::exports::{Exported, RunExports};
 use crate::scenario::Scenario;
 use bevy_ecs::prelude::*;
 use std::path::Path;
-use systems::core::{SimClock, SimPlugin};
+use systems::core::SimPlugin;
 use systems::localization::{Filter, Localizers};
 
 /// The plugins of the outputs asked for, in the order they join the schedule: the .rrd
@@ -29,7 +33,10 @@ pub fn output_plugins(
 ) -> anyhow::Result<Vec<Box<dyn SimPlugin>>> {
     let mut plugins: Vec<Box<dyn SimPlugin>> = Vec::new();
     if let Some(path) = rrd {
+        #[cfg(feature = "rrd")]
         plugins.push(Box::new(RrdPlugin::new(path, scenario)?));
+        #[cfg(not(feature = "rrd"))]
+        return Err(crate::record::without_rrd(path));
     }
     if let Some(out) = &exports.carmen_out {
         let export = CarmenExport::new(scenario, out)?;
@@ -92,14 +99,17 @@ pub(crate) fn finish_files(
     exports: &RunExports,
 ) -> (Exported, Failures) {
     let mut failures = Failures::default();
-    if w.contains_resource::<RrdRecorder>() {
-        record_slam_final(w);
-    }
-    if let Some(mut rec) = w.remove_resource::<RrdRecorder>()
-        && let Err(e) = rec.finish()
+    #[cfg(feature = "rrd")]
     {
-        failures.errors.push(format!("{e:#}"));
-        failures.recording = true;
+        if w.contains_resource::<RrdRecorder>() {
+            record_slam_final(w);
+        }
+        if let Some(mut rec) = w.remove_resource::<RrdRecorder>()
+            && let Err(e) = rec.finish()
+        {
+            failures.errors.push(format!("{e:#}"));
+            failures.recording = true;
+        }
     }
     let exported = exports.finish(w, scenario, &mut failures.errors);
     (exported, failures)
@@ -186,9 +196,12 @@ impl<T> std::error::Error for OutputsFailed<T> {}
 /// The camera frames still being rendered go to the recordings; the worker's error, if any.
 fn finish_frames(w: &mut World) -> Option<String> {
     let (mut frames, error) = w.remove_resource::<RecordedFrames>()?.finish();
-    let now = w.resource::<SimClock>().now();
-    if let Some(mut r) = w.get_resource_mut::<RrdRecorder>() {
-        log_frames_rrd(&mut r, &mut frames, now);
+    #[cfg(feature = "rrd")]
+    {
+        let now = w.resource::<systems::core::SimClock>().now();
+        if let Some(mut r) = w.get_resource_mut::<RrdRecorder>() {
+            log_frames_rrd(&mut r, &mut frames, now);
+        }
     }
     if let Some(mut export) = w.get_resource_mut::<McapExport>() {
         export.write_frames(&mut frames);

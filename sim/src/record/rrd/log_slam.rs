@@ -5,10 +5,10 @@
 //! the odometry frame for a log of `sim run --carmen-out`), and the default layout
 //! ([`super::blueprint`]). The `sim_time` timeline counts seconds from the log's first record.
 
-use super::path_trace::PathTrace;
 use super::slam::{SlamTrack, log_slam_scan, log_slam_state, slam_entity};
 use super::stream::RrdStream;
 use super::{close_recording, open_recording};
+use crate::record::path_trace::PathTrace;
 use std::path::Path;
 use systems::core::Pose2;
 use systems::localization::ScanEstimator;

@@ -40,7 +40,6 @@ pub mod localizer_status;
 pub mod log_slam;
 pub mod navigation;
 pub mod outdoor;
-pub mod path_trace;
 mod plugin;
 pub mod rows;
 pub mod slam;
@@ -48,11 +47,11 @@ pub mod stream;
 
 pub use plugin::RrdPlugin;
 
+use crate::record::axis_scale::AxisScale;
+use crate::record::path_trace::PathTrace;
 use crate::scenario::RecordConfig;
 use belief::Cloud;
 use bevy_ecs::prelude::*;
-use blueprint::AxisScale;
-use path_trace::PathTrace;
 use std::collections::VecDeque;
 use std::path::Path;
 use stream::RrdStream;

@@ -4,7 +4,9 @@
 use super::McapExport;
 use super::convert::*;
 use super::robot::RobotTopics;
-use crate::record::frames::{RecordedFrame, RecordedFrames, collect_frames, record_frames_rrd};
+#[cfg(feature = "rrd")]
+use crate::record::frames::record_frames_rrd;
+use crate::record::frames::{RecordedFrame, RecordedFrames, collect_frames};
 use crate::record::mcap::McapRecorder;
 use crate::record::mcap::messages::{Image, Range};
 use crate::record::mcap::stamp_ns;
@@ -58,6 +60,7 @@ impl SimPlugin for McapPlugin {
         // ran in). No order with systems not in the schedule: it would change the executor's
         // order of the others.
         match frames {
+            #[cfg(feature = "rrd")]
             Some(f) if f.jpeg => {
                 schedule.add_systems(system.after(collect_frames).before(record_frames_rrd))
             }

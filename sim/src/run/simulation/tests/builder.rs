@@ -221,3 +221,33 @@ fn a_look_ahead_longer_than_the_map_still_drives() {
     let end = s.robot("r1").unwrap().pose();
     assert!(end.distance(&start) > 1.0, "{start:?} -> {end:?}");
 }
+
+/// Built without the `rrd` feature (as the fuzz crate builds it), a run asked for a .rrd is
+/// refused before its first tick, naming the file and the feature; without one it runs.
+#[cfg(not(feature = "rrd"))]
+#[test]
+fn a_build_without_the_recording_refuses_a_rrd_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("patrol.rrd");
+    let e = Simulation::load("maze_run")
+        .duration(0.5)
+        .threads(1)
+        .rrd(&path)
+        .build()
+        .err()
+        .expect("a .rrd refused");
+    let text = format!("{e:#}");
+    assert!(
+        text.contains("patrol.rrd") && text.contains("`rrd`"),
+        "{text}"
+    );
+    assert!(!path.exists());
+    let run = Simulation::load("maze_run")
+        .duration(0.5)
+        .threads(1)
+        .build()
+        .unwrap()
+        .run()
+        .unwrap();
+    assert_eq!(run.summary.sim_time_s, 0.5);
+}

@@ -1,11 +1,11 @@
-//! Driven paths as the .rrd draws them: line strips sent as new segments only ([`PathTrace::take_new`]),
-//! each continuing from where the last one ended, so a recording grows linearly with the run
-//! (the blueprint draws a path's rows from the start to the time cursor). Points are kept only
-//! where the path bends: a point
-//! is dropped while every point since the last kept one stays within [`TOLERANCE`] of the
-//! straight line from that kept point to the newest one (a streaming form of the
-//! Reumann–Witkam / Douglas–Peucker simplification). A 190 m park route keeps a few hundred
-//! points instead of thousands; nothing drawn moves by more than a centimetre.
+//! Driven paths as the .rrd and the HTML report draw them: line strips sent as new segments
+//! only ([`PathTrace::take_new`]), each continuing from where the last one ended, so a
+//! recording grows linearly with the run (the blueprint draws a path's rows from the start to
+//! the time cursor). Points are kept only where the path bends: a point is dropped while every
+//! point since the last kept one stays within [`TOLERANCE`] of the straight line from that kept
+//! point to the newest one (a streaming form of the Reumann–Witkam / Douglas–Peucker
+//! simplification). A 190 m park route keeps a few hundred points instead of thousands;
+//! nothing drawn moves by more than a centimetre.
 //!
 //! A path breaks where it jumps: a point farther from the previous one than [`JUMP_BASE`] plus
 //! [`JUMP_SPEED`] times the time between them (a localizer's estimate snapping to another
