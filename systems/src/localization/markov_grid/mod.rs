@@ -4,8 +4,9 @@
 //! cell of a coarse lattice (default 0.25 m × 0.25 m × 10°) over the free space of the map:
 //!
 //! - prediction ([`prediction`]): every cell's mass moves by the odometry motion as seen from
-//!   its heading (trilinear split), then a Gaussian blur adds the rest of the motion noise of
-//!   the shared odometry model (α1..α4);
+//!   its heading, by whole cells with the fraction carried as a sub-cell offset per θ layer
+//!   (no interpolation blur), then a Gaussian blur adds the motion noise of the shared
+//!   odometry model (α1..α4) once it amounts to a quarter of a cell² (or bin²);
 //! - correction ([`correction`]): the likelihood field on the map's distance field, every beam
 //!   endpoint projected from every cell centre; log-likelihoods summed over beams, optionally
 //!   tempered by `likelihood_exponent` (the beams of a scan are not independent, Thrun §6.4.3);
@@ -32,6 +33,7 @@ use super::motion_model::{OdometryMotionModel, moved_enough};
 use crate::core::{Pose2, wrap_angle};
 use correction::PaddedField;
 use layout::{Layout, Span};
+use prediction::SubCell;
 use rayon::prelude::*;
 use std::borrow::Cow;
 
@@ -88,6 +90,10 @@ pub struct MarkovGrid {
     pub layout: Layout,
     /// Probability per cell, θ-layer-major (k · ny + j) · nx + i; sums to 1.
     pub belief: Vec<f32>,
+    /// Where the belief's mass sits within its cells ([`prediction`]).
+    pub sub_cell: SubCell,
+    /// Motion noise not yet blurred in: position (cells²) and heading (bins²) variance.
+    pending_noise: [f64; 2],
     scratch: Vec<f32>,
     tmp: Vec<f32>,
     field: Option<PaddedField>,
@@ -100,6 +106,11 @@ pub struct MarkovGrid {
     /// The odometry pose of the scan `estimate` was refined on.
     estimate_odom: Option<Pose2>,
 }
+
+/// The motion noise variance (cells², bins²) worth a blur pass over the grid: smaller ones
+/// add up until they reach it, so a tracked robot's belief is not blurred at every update
+/// (about every 25th at 0.25 m per update and α = 0.01).
+const BLUR_VARIANCE: f64 = 0.25;
 
 /// Cells between two sample cells of the selective update (about 2 000 of the hospital's
 /// 0.97 million free cells × bins).
@@ -167,6 +178,8 @@ impl MarkovGrid {
         let layout = Layout::new(&map.grid, config.resolution, config.angular_bins);
         let mut g = MarkovGrid {
             belief: vec![0.0; layout.len()],
+            sub_cell: SubCell::centred(&layout),
+            pending_noise: [0.0; 2],
             scratch: vec![0.0; layout.len()],
             tmp: Vec::new(),
             sample: sample_cells(&layout),
@@ -239,30 +252,26 @@ impl MarkovGrid {
     /// Prediction for the odometry motion `from` → `to`.
     pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
-        prediction::shift(&self.layout, &d, &self.belief, &mut self.scratch);
+        let l = &self.layout;
+        prediction::shift(l, &d, &mut self.sub_cell, &self.belief, &mut self.scratch);
         std::mem::swap(&mut self.belief, &mut self.scratch);
-        // the trilinear split already spreads ~1/6 cell² on average
-        let extra = |sigma: f64| (sigma * sigma - 1.0 / 6.0).max(0.0).sqrt();
         // a blur as wide as the grid already spreads the mass over all of it: capped there, so
         // a jump of the odometry does not ask for a kernel as long as the jump
-        let (l, most) = (&self.layout, |s: f64, n: usize| s.min(n as f64));
-        let s_xy = most(
-            extra(d.sd_trans.hypot(d.trans * d.sd_rot1) / l.resolution),
-            l.nx.max(l.ny),
-        );
-        if s_xy > 0.25 {
-            let k = prediction::kernel(s_xy);
+        let cap = |n: usize| (n * n) as f64;
+        let xy = (d.sd_trans.hypot(d.trans * d.sd_rot1) / l.resolution).powi(2);
+        let th = (d.sd_rot1.hypot(d.sd_rot2) / l.theta_step()).powi(2);
+        self.pending_noise[0] = (self.pending_noise[0] + xy).min(cap(l.nx.max(l.ny)));
+        self.pending_noise[1] = (self.pending_noise[1] + th).min(cap(l.n_theta));
+        if self.pending_noise[0] >= BLUR_VARIANCE {
+            let k = prediction::kernel_of_variance(self.pending_noise[0]);
             prediction::blur_xy(&self.layout, &k, &mut self.belief, &mut self.tmp);
+            self.pending_noise[0] = 0.0;
         }
-        let l = &self.layout;
-        let s_th = most(
-            extra(d.sd_rot1.hypot(d.sd_rot2) / l.theta_step()),
-            l.n_theta,
-        );
-        if s_th > 0.25 {
-            let k = prediction::kernel(s_th);
+        if self.pending_noise[1] >= BLUR_VARIANCE {
+            let k = prediction::kernel_of_variance(self.pending_noise[1]);
             prediction::blur_theta(&self.layout, &k, &self.belief, &mut self.scratch);
             std::mem::swap(&mut self.belief, &mut self.scratch);
+            self.pending_noise[1] = 0.0;
         }
         if !self.normalise() {
             self.fill_uniform();
@@ -303,18 +312,20 @@ impl MarkovGrid {
             .collect();
         let field = self.field.as_ref().expect("built above");
         let layout = &self.layout;
-        let sample = &self.sample;
+        let (sample, sub) = (&self.sample, &self.sub_cell);
         let sampled: Vec<Vec<f32>> = self
             .scratch
             .par_chunks_mut(layout.layer())
             .enumerate()
             .map(|(k, out)| {
-                let (s, c) = layout.theta(k).sin_cos();
+                // the endpoints seen from this layer's cell poses: centre plus offset
+                let (s, c) = sub.heading(layout, k).sin_cos();
+                let (ox, oy) = sub.offset(layout, k);
                 let offsets: Vec<isize> = points
                     .iter()
                     .map(|p| {
                         let (x, y) = (p[0] as f64, p[1] as f64);
-                        field.offset(c * x - s * y, s * x + c * y)
+                        field.offset(ox + c * x - s * y, oy + s * x + c * y)
                     })
                     .collect();
                 let spans = active.map_or(&layout.spans[..], |a| &a[k][..]);
@@ -538,7 +549,7 @@ impl MarkovGrid {
                     let (i, j) = (i as usize, j as usize);
                     let w = self.belief[k * layer + j * l.nx + i] as f64;
                     if w > 0.0 {
-                        let (x, y) = l.centre(i, j);
+                        let (x, y) = self.sub_cell.position(l, k, i, j);
                         // heading relative to the best cell's, so the mean does not wrap
                         cells.push((x, y, dk as f64 * l.theta_step(), w));
                     }
@@ -561,7 +572,7 @@ impl MarkovGrid {
         cov[1][1] += l.resolution * l.resolution / 12.0;
         cov[2][2] += l.theta_step() * l.theta_step() / 12.0;
         Some(PoseEstimate {
-            pose: Pose2::new(mx, my, wrap_angle(l.theta(k0) + mt)),
+            pose: Pose2::new(mx, my, wrap_angle(self.sub_cell.heading(l, k0) + mt)),
             covariance: cov,
             weight: total,
         })
@@ -572,12 +583,12 @@ impl MarkovGrid {
         let l = &self.layout;
         let mut m = 0.0;
         for k in 0..l.n_theta {
-            if wrap_angle(l.theta(k) - pose.theta).abs() > angle {
+            if wrap_angle(self.sub_cell.heading(l, k) - pose.theta).abs() > angle {
                 continue;
             }
             for s in &l.spans {
                 for i in s.i0..s.i0 + s.len {
-                    let (x, y) = l.centre(i as usize, s.j as usize);
+                    let (x, y) = self.sub_cell.position(l, k, i as usize, s.j as usize);
                     if (x - pose.x).hypot(y - pose.y) <= radius {
                         m += self.belief[k * l.layer() + s.j as usize * l.nx + i as usize] as f64;
                     }
