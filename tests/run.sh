@@ -61,9 +61,10 @@ SIM_BIN="${CARGO_TARGET_DIR:-target}/release/sim" tests/slurm/run.sh
 
 # sim built without its .rrd recording (no `rrd` feature), as the fuzz crate below builds it:
 # a run asked for a .rrd is refused by name (the one test, which must run)
-cargo test -p sim --no-default-features --lib -- --exact \
-    run::simulation::tests::builder::a_build_without_the_recording_refuses_a_rrd_by_name |
-    tee /dev/stderr | grep "test result: ok. 1 passed" >/dev/null
+no_rrd="$(cargo test -p sim --no-default-features --lib -- --exact \
+    run::simulation::tests::builder::a_build_without_the_recording_refuses_a_rrd_by_name)"
+echo "$no_rrd"
+grep -q "test result: ok. 1 passed" <<<"$no_rrd" || { echo "the test without rrd did not run" >&2; exit 1; }
 
 # Fuzzing (tests/fuzz, cargo fuzz on the stable toolchain): each reader of user files runs its
 # seeds and every input that once failed, then 15 s of coverage-guided mutations. The long run

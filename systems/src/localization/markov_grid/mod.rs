@@ -8,8 +8,9 @@
 //!   (no interpolation blur), then a Gaussian blur adds the motion noise of the shared
 //!   odometry model (α1..α4) once it amounts to a quarter of a cell² (or bin²);
 //! - correction ([`correction`]): the likelihood field on the map's distance field, every beam
-//!   endpoint projected from every cell centre; log-likelihoods summed over beams, optionally
-//!   tempered by `likelihood_exponent` (the beams of a scan are not independent, Thrun §6.4.3);
+//!   endpoint projected from every cell's pose (centre plus offset); log-likelihoods summed
+//!   over beams, optionally tempered by `likelihood_exponent` (the beams of a scan are not
+//!   independent, Thrun §6.4.3);
 //! - a small uniform share (`uniform_mix`) keeps every free cell possible, so a kidnapped
 //!   robot can be found again;
 //! - the estimate is the most probable cell refined by the weighted mean of its 3 × 3 × 3
