@@ -21,10 +21,14 @@
 //!    itself converged when the best member's cost has stayed low for a few updates, and then
 //!    runs only `tracking_generations` per update.
 //!
-//! Two additions of ours make it work on a floor as large and repetitive as the hospital's
+//! Three additions of ours make it work on a floor as large and repetitive as the hospital's
 //! (without them the best member wanders between look-alike places): the best member is
-//! refined locally at every update ([`Population::refine_best`]), and it moves with the
-//! noise-free odometry while the others draw from the motion model.
+//! refined locally at every update ([`Population::refine_best`]); it moves with the
+//! noise-free odometry while the others draw from the motion model; and while converged, the
+//! member the estimate follows is chosen, and refined, by its cost plus a Gaussian prior
+//! around where the odometry carried the last estimate (a maximum a posteriori choice,
+//! [`super::de_population::Gate`]), so it does not slide along a corridor to a pose that fits
+//! one scan marginally better.
 
 use super::de_population::{Population, RangeMetric, range_costs, three_others};
 use super::de_tracker::{CycleSettings, DeTracker};
@@ -273,7 +277,7 @@ mod tests {
     use crate::localization::test_drive::{convergence, corridor_errors, de_motion, hospital};
 
     /// On the hospital map, from global initialisation the filter converges on the corridor
-    /// drive and then tracks.
+    /// drive and then tracks: nine in ten estimates after convergence within 10 cm.
     #[test]
     fn de_filter_converges_from_global_initialisation() {
         let map = hospital();
@@ -290,7 +294,15 @@ mod tests {
         });
         let (since, tracked, n) = convergence(&errors);
         let since = since.unwrap_or_else(|| panic!("never converged in {n} updates"));
-        assert!(since < 40 && tracked > 0.9, "{since} {tracked}");
+        // the gate's odometry prior keeps the estimate from sliding along the corridor to a pose
+        // that fits one scan marginally better
+        let mut after: Vec<f64> = errors[since..].iter().map(|e| e.0).collect();
+        after.sort_by(f64::total_cmp);
+        let p90 = after[after.len() * 9 / 10];
+        assert!(
+            since < 40 && tracked > 0.97 && p90 < 0.1,
+            "{since} {tracked} {p90}"
+        );
         let t = &f.tracker;
         assert!(t.converged && t.population.len() == f.config.min_population);
         assert!(t.evaluations < 2_000_000, "{}", t.evaluations);

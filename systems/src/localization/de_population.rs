@@ -164,14 +164,15 @@ impl Population {
     }
 
     /// The member the estimate follows: with a `gate` (a tracking filter's prediction), the
-    /// lowest-cost member within the gate, so the estimate does not jump to a look-alike place
-    /// that fits one scan as well (the filter's convergence bookkeeping lets go of the gate if
-    /// the fit stays bad); otherwise the best member.
+    /// member within the gate of lowest cost weighed by the gate's prior, so the estimate does
+    /// not jump to a look-alike place that fits one scan as well (the filter's convergence
+    /// bookkeeping lets go of the gate if the fit stays bad); otherwise the best member.
     pub fn leader(&self, gate: Option<&Gate>) -> usize {
         if let Some(g) = gate {
+            let weighed = |i: usize| g.weighed(&self.poses[i], self.costs[i]);
             let inside = (0..self.len())
                 .filter(|&i| close(&self.poses[i], &g.centre, g.radius, g.angle))
-                .min_by(|&a, &b| self.costs[a].total_cmp(&self.costs[b]).then(a.cmp(&b)));
+                .min_by(|&a, &b| weighed(a).total_cmp(&weighed(b)).then(a.cmp(&b)));
             if let Some(i) = inside {
                 return i;
             }
@@ -250,7 +251,8 @@ impl Population {
 impl Population {
     /// Local refinement of the best member (our addition, as in the improved scan matcher):
     /// `rounds` rounds of `samples` Gaussian perturbations of it, the spread `sd` (m, m, rad)
-    /// halving each round; the best candidate replaces it if better. Returns the evaluations.
+    /// halving each round; the best candidate replaces it if better (weighed by the `gate`'s
+    /// prior when there is one). Returns the evaluations.
     #[allow(clippy::too_many_arguments)]
     pub fn refine_best(
         &mut self,
@@ -258,6 +260,7 @@ impl Population {
         beams: &BeamSubset,
         metric: RangeMetric,
         leader: usize,
+        gate: Option<&Gate>,
         rounds: usize,
         samples: usize,
         sd: [f64; 3],
@@ -282,10 +285,14 @@ impl Population {
                 ]);
             }
             range_costs(map, beams, metric, &candidates, &mut costs);
+            let weighed = |p: &[f64; 3], cost: f64| gate.map_or(cost, |g| g.weighed(p, cost));
+            let w: Vec<f64> = (0..samples)
+                .map(|i| weighed(&candidates[i], costs[i]))
+                .collect();
             let k = (0..samples)
-                .min_by(|&i, &j| costs[i].total_cmp(&costs[j]).then(i.cmp(&j)))
+                .min_by(|&i, &j| w[i].total_cmp(&w[j]).then(i.cmp(&j)))
                 .unwrap_or(0);
-            if costs[k] < self.costs[b] {
+            if w[k] < weighed(&self.poses[b], self.costs[b]) {
                 self.poses[b] = candidates[k];
                 self.costs[b] = costs[k];
             }
@@ -296,12 +303,28 @@ impl Population {
 }
 
 /// Where a tracking filter expects its estimate: within `radius` (m) and `angle` (rad) of
-/// `centre`.
+/// `centre`, most likely near it. Within the gate a member's cost is weighed with a Gaussian
+/// prior around `centre` (standard deviations `sigma`: m, rad), `cost_per_nat` of cost for each
+/// unit of its negative log-density: the member the estimate follows is then the most probable
+/// one given the odometry as well as the scan, not one that fits a single scan marginally better
+/// farther along a corridor.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gate {
     pub centre: [f64; 3],
     pub radius: f64,
     pub angle: f64,
+    pub sigma: [f64; 2],
+    pub cost_per_nat: f64,
+}
+
+impl Gate {
+    /// `cost` of a member at `p` plus the prior's share.
+    pub fn weighed(&self, p: &[f64; 3], cost: f64) -> f64 {
+        let c = &self.centre;
+        let d2 = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)) / self.sigma[0].powi(2)
+            + (wrap_angle(p[2] - c[2]) / self.sigma[1]).powi(2);
+        cost + self.cost_per_nat * 0.5 * d2
+    }
 }
 
 /// Smallest variances of the DE estimates (5 cm, 5 cm, 1°): a lone best member says nothing

@@ -41,7 +41,16 @@ pub struct DeTracker {
     /// Cost evaluations so far.
     pub evaluations: u64,
     pub estimate: Option<PoseEstimate>,
+    /// The motion model's standard deviations (m, rad) for the last motion the population made.
+    step_sd: [f64; 2],
+    /// The gate prior's cost per nat for the scan being scored ([`Gate::cost_per_nat`]).
+    cost_per_nat: f64,
 }
+
+/// The gate prior's smallest standard deviations (1.25 cm, 0.5°): the estimate's own
+/// uncertainty before the motion's is added. Narrow, so that between look-alike poses along a
+/// corridor the one the odometry predicts wins unless the scan clearly prefers another.
+const PRIOR_FLOOR: [f64; 2] = [0.0125, 0.0087];
 
 impl DeTracker {
     /// `n` members drawn from the initial belief.
@@ -57,17 +66,23 @@ impl DeTracker {
             updates: 0,
             evaluations: 0,
             estimate: None,
+            step_sd: [0.0; 2],
+            cost_per_nat: 0.0,
         }
     }
 
     /// While converged, the estimate follows the best member within 1 m and 0.3 rad of where the
-    /// last estimate has moved to.
+    /// last estimate has moved to, weighed by a prior around it as wide as [`PRIOR_FLOOR`] and
+    /// the motion's noise.
     fn gate(&self) -> Option<Gate> {
         let t = self.tracked.filter(|_| self.converged)?;
+        let sd = |k: usize| PRIOR_FLOOR[k].hypot(self.step_sd[k]);
         Some(Gate {
             centre: [t.x, t.y, t.theta],
             radius: 1.0,
             angle: 0.3,
+            sigma: [sd(0), sd(1)],
+            cost_per_nat: self.cost_per_nat,
         })
     }
 
@@ -94,6 +109,10 @@ impl DeTracker {
                 return false;
             }
             let d = s.motion.delta(&last, odom);
+            self.step_sd = [
+                d.sd_trans.hypot(d.trans * d.sd_rot1),
+                d.sd_rot1.hypot(d.sd_rot2),
+            ];
             let lead = self.population.leader(self.gate().as_ref());
             self.population.move_by(s.motion, &d, lead, &mut self.rng);
             // the estimate moves with the noise-free odometry
@@ -119,12 +138,16 @@ impl DeTracker {
         }
         self.population.evaluate(map, beams, s.metric);
         self.evaluations += self.population.len() as u64;
-        let lead = self.population.leader(self.gate().as_ref());
+        // a cost of `converge_cost` (a good fit's mean range error) is worth about a nat per beam
+        self.cost_per_nat = s.converge_cost / beams.len() as f64;
+        let gate = self.gate();
+        let lead = self.population.leader(gate.as_ref());
         self.evaluations += self.population.refine_best(
             map,
             beams,
             s.metric,
             lead,
+            gate.as_ref(),
             s.refine_rounds,
             s.refine_samples,
             s.refine_sd,

@@ -3,13 +3,35 @@
 //! search (three rounds of 5 × 5 × 5 poses, the step halving each round) maximises the scan's
 //! log-likelihood under the laser's own σ_hit on the map's distance field — the likelihood
 //! field of Probabilistic Robotics §6.4 evaluated by the same kernel MCL weighs particles with.
+//! Given a prior (the tracked estimate moved by the odometry), it maximises the posterior
+//! instead: where one scan says little, as along a corridor, the prior decides.
 
 use crate::core::{Pose2, wrap_angle};
 use crate::localization::map::LocalizationMap;
 use crate::localization::mcl::{LaserModelParams, sensor_model};
 
+/// A Gaussian belief about the pose before the scan: the refinement maximises the posterior
+/// (scan log-likelihood plus the prior's log-density) instead of the scan's likelihood alone.
+#[derive(Clone, Copy, Debug)]
+pub struct Prior {
+    pub pose: Pose2,
+    pub sigma_xy: f64,
+    pub sigma_theta: f64,
+}
+
+impl Prior {
+    /// The prior's log-density at `(x, y, theta)` up to a constant.
+    fn log_density(&self, x: f64, y: f64, theta: f64) -> f64 {
+        let (dx, dy) = (x - self.pose.x, y - self.pose.y);
+        let dt = wrap_angle(theta - self.pose.theta);
+        -0.5 * ((dx * dx + dy * dy) / (self.sigma_xy * self.sigma_xy)
+            + dt * dt / (self.sigma_theta * self.sigma_theta))
+    }
+}
+
 /// The pose near `start` (within about `half_xy` m and `half_theta` rad) where the endpoints
-/// `points` (base frame) fit the map best.
+/// `points` (base frame) fit the map best, weighed by `prior` when there is one.
+#[allow(clippy::too_many_arguments)]
 pub fn refine_pose(
     map: &LocalizationMap,
     laser: &LaserModelParams,
@@ -18,6 +40,7 @@ pub fn refine_pose(
     start: Pose2,
     half_xy: f64,
     half_theta: f64,
+    prior: Option<Prior>,
 ) -> Pose2 {
     if points.is_empty() {
         return start;
@@ -47,6 +70,11 @@ pub fn refine_pose(
         // the kernel multiplies w by (1 + Σ table): with w = 1 that is 1 + Σ ln pz
         let mut w = vec![1.0; xs.len()];
         sensor_model::weigh_likelihood_field(&map.field, &table, points, &xs, &ys, &ths, &mut w);
+        if let Some(prior) = prior {
+            for (k, w) in w.iter_mut().enumerate() {
+                *w += prior.log_density(xs[k], ys[k], ths[k]);
+            }
+        }
         // ties: the first (most negative offsets); the centre (index 62) wins ties against
         // nothing in particular, which is fine for a maximiser
         let k = (0..w.len())

@@ -241,7 +241,9 @@ fn converges_from_global_initialisation_and_tracks() {
     );
     // from one update to the next the estimate moves as the robot did: along the corridor the
     // most probable cell alternated between neighbours, and without the tracked start the
-    // estimate jumped by up to 0.48 m more than the robot moved (90 % within 8.4 cm)
+    // estimate jumped by up to 0.48 m more than the robot moved (90 % within 8.4 cm); with the
+    // tracked start but no prior, by up to 0.12 m (90 % within 2.1 cm), one scan's noise
+    // peaking elsewhere along the corridor
     let mut jumps: Vec<f64> = poses[since..]
         .windows(2)
         .map(|w| {
@@ -252,7 +254,7 @@ fn converges_from_global_initialisation_and_tracks() {
     jumps.sort_by(f64::total_cmp);
     let (p90, max) = (jumps[jumps.len() * 9 / 10], jumps[jumps.len() - 1]);
     assert!(
-        p90 < 0.075 && max < 0.3,
+        p90 < 0.02 && max < 0.06,
         "jumps: 90 % within {p90} m, max {max} m"
     );
 }
