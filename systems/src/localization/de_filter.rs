@@ -21,14 +21,19 @@
 //!    itself converged when the best member's cost has stayed low for a few updates, and then
 //!    runs only `tracking_generations` per update.
 //!
-//! Three additions of ours make it work on a floor as large and repetitive as the hospital's
-//! (without them the best member wanders between look-alike places): the best member is
-//! refined locally at every update ([`Population::refine_best`]); it moves with the
-//! noise-free odometry while the others draw from the motion model; and while converged, the
-//! member the estimate follows is chosen, and refined, by its cost plus a Gaussian prior
-//! around where the odometry carried the last estimate (a maximum a posteriori choice,
-//! [`super::de_population::Gate`]), so it does not slide along a corridor to a pose that fits
-//! one scan marginally better.
+//! Additions of ours make it work on a floor as large and repetitive as the hospital's (without
+//! them the best member wanders between look-alike places, or settles on one): the best member
+//! is refined locally at every update ([`Population::refine_best`]); it moves with the
+//! noise-free odometry while the others draw from the motion model; while the filter searches,
+//! the worst members are replaced by poses drawn from the scan (Mixture MCL's dual proposal
+//! [Thrun 2001, §4], `injection_candidates`), so the true place is in the population from the
+//! first scans on; once converged, the member the estimate follows is chosen, and refined, by
+//! its cost plus a Gaussian prior around where the odometry carried the last estimate (a
+//! maximum a posteriori choice, [`super::de_population::Gate`]), so it does not slide along a
+//! corridor to a pose that fits one scan marginally better; and a place outside the gate that
+//! fits clearly better for several updates in a row takes the estimate over (the sequential
+//! test of [`super::de_tracker`]), so a filter that settled on a look-alike wing moves to the
+//! right one without searching the whole floor again.
 
 use super::de_population::{Population, RangeMetric, range_costs, three_others};
 use super::de_tracker::{CycleSettings, DeTracker};
@@ -74,6 +79,10 @@ pub struct DeFilterConfig {
     pub refine_rounds: usize,
     pub refine_samples: usize,
     pub refine_sd: [f64; 3],
+    /// While the filter searches (not converged), the worst members are replaced at every
+    /// update by poses drawn from the scan, as Mixture MCL's dual proposal does
+    /// ([`super::mcl::injection`]): this many candidates per round (0: off, the thesis's filter).
+    pub injection_candidates: usize,
 }
 
 impl Default for DeFilterConfig {
@@ -101,6 +110,7 @@ impl Default for DeFilterConfig {
             refine_rounds: 4,
             refine_samples: 32,
             refine_sd: [0.2, 0.2, 0.05],
+            injection_candidates: 20_000,
         }
     }
 }
@@ -147,6 +157,7 @@ impl DeFilterConfig {
             refine_samples: self.refine_samples,
             refine_sd: self.refine_sd,
             reseed: self.population,
+            injection_candidates: self.injection_candidates,
         }
     }
 }
@@ -306,6 +317,31 @@ mod tests {
         let t = &f.tracker;
         assert!(t.converged && t.population.len() == f.config.min_population);
         assert!(t.evaluations < 2_000_000, "{}", t.evaluations);
+    }
+
+    /// The scan proposal puts the true place in the population from the first scans: over
+    /// eight seeds the filter is within 0.2 m and 5° from its third update on (without it,
+    /// from the sixth to the twentieth).
+    #[test]
+    fn the_scan_proposal_finds_the_robot_within_three_updates() {
+        let map = hospital();
+        let first: Vec<Option<usize>> = (0..8)
+            .map(|seed| {
+                let mut f = DeFilter::new(
+                    DeFilterConfig {
+                        motion: de_motion(),
+                        ..DeFilterConfig::default()
+                    },
+                    &map,
+                    stream_rng(seed, "test", "de"),
+                );
+                let errors = corridor_errors(|beams, odom| {
+                    f.update(&map, beams, odom).then(|| f.estimate().unwrap())
+                });
+                convergence(&errors).0
+            })
+            .collect();
+        assert!(first.iter().all(|s| s.is_some_and(|s| s <= 2)), "{first:?}");
     }
 
     /// Properties under sensor faults: the range costs of any scan from any pose are finite and

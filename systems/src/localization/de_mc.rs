@@ -53,6 +53,11 @@ pub struct DeMcConfig {
     pub refine_rounds: usize,
     pub refine_samples: usize,
     pub refine_sd: [f64; 3],
+    /// While the filter searches (not converged), the worst members are replaced at every
+    /// update by poses drawn from the scan, as Mixture MCL's dual proposal does
+    /// ([`super::mcl::injection`]): this many candidates per round (0: off, the default; unlike
+    /// the DE filter's, the chains' convergence did not get faster with it).
+    pub injection_candidates: usize,
 }
 
 impl Default for DeMcConfig {
@@ -75,6 +80,7 @@ impl Default for DeMcConfig {
             refine_rounds: 4,
             refine_samples: 32,
             refine_sd: [0.2, 0.2, 0.05],
+            injection_candidates: 0,
         }
     }
 }
@@ -121,6 +127,7 @@ impl DeMcConfig {
             refine_samples: self.refine_samples,
             refine_sd: self.refine_sd,
             reseed: self.population,
+            injection_candidates: self.injection_candidates,
         }
     }
 }

@@ -318,6 +318,11 @@ pub struct Gate {
 }
 
 impl Gate {
+    /// Whether `p` is within the gate.
+    pub fn contains(&self, p: &[f64; 3]) -> bool {
+        close(p, &self.centre, self.radius, self.angle)
+    }
+
     /// `cost` of a member at `p` plus the prior's share.
     pub fn weighed(&self, p: &[f64; 3], cost: f64) -> f64 {
         let c = &self.centre;

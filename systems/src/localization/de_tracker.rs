@@ -1,14 +1,18 @@
 //! The update cycle both DE localizers share ([`super::de_filter`], [`super::de_mc`];
-//! [Hospital thesis §3.9]): move the population by odometry, score it on the new scan,
-//! refine the best member locally, let the method evolve the population, keep the elite, update
-//! the convergence state and the estimate; once a converged filter is lost, a fresh population
-//! spread over the whole floor searches again.
+//! [Hospital thesis §3.9]): move the population by odometry, (while searching) replace the
+//! worst members by poses drawn from the scan, score it on the new scan, refine the best member
+//! locally, let the method evolve the population, keep the elite, (while converged) let a
+//! clearly better place outside the gate challenge the estimate, update the convergence state
+//! and the estimate; once a converged filter is lost, a fresh population spread over the whole
+//! floor searches again.
 
 use super::de_population::{ESTIMATE_FLOOR, Gate, Population, RangeMetric, convergence};
 use super::map::LocalizationMap;
-use super::mcl::{BeamSubset, InitialBelief, PoseEstimate};
+use super::mcl::injection::scan_proposal;
+use super::mcl::sensor_model::likelihood_table;
+use super::mcl::{BeamSubset, InitialBelief, LaserModelParams, PoseEstimate};
 use super::motion_model::{OdometryMotionModel, moved_enough};
-use crate::core::{Pose2, SimRng};
+use crate::core::{Pose2, SimRng, wrap_angle};
 
 /// The settings of the shared cycle (fields of each method's configuration).
 #[derive(Clone, Copy, Debug)]
@@ -24,6 +28,9 @@ pub struct CycleSettings<'a> {
     pub refine_sd: [f64; 3],
     /// Members of a fresh global population when the filter loses convergence (0: never).
     pub reseed: usize,
+    /// Candidates per round of the scan proposal that replaces the worst members while the
+    /// filter searches (0: off).
+    pub injection_candidates: usize,
 }
 
 /// The state of a DE localizer apart from its method's own parameters.
@@ -45,7 +52,17 @@ pub struct DeTracker {
     step_sd: [f64; 2],
     /// The gate prior's cost per nat for the scan being scored ([`Gate::cost_per_nat`]).
     cost_per_nat: f64,
+    /// While converged: a place outside the gate whose best member has fitted clearly better
+    /// than the leader, carried by the odometry, and for how many updates in a row.
+    challenger: Option<(Pose2, u32)>,
+    /// The likelihood field's lookup table for the scan proposal (scans of one range_max).
+    table: Option<Box<[f32; 256]>>,
 }
+
+/// A challenger must cost at most this share of the leader's cost…
+const CHALLENGE_RATIO: f64 = 0.8;
+/// …for this many updates in a row before the estimate moves to it.
+const CHALLENGE_UPDATES: u32 = 4;
 
 /// The gate prior's smallest standard deviations (1.25 cm, 0.5°): the estimate's own
 /// uncertainty before the motion's is added. Narrow, so that between look-alike poses along a
@@ -68,6 +85,8 @@ impl DeTracker {
             estimate: None,
             step_sd: [0.0; 2],
             cost_per_nat: 0.0,
+            challenger: None,
+            table: None,
         }
     }
 
@@ -100,6 +119,60 @@ impl DeTracker {
         self.predict(odom, s) && self.correct(map, beams, s, evolve)
     }
 
+    /// The sequential test that lets a converged filter move to a look-alike place it settled
+    /// next to by mistake (the gate would otherwise hold it there until the fit turned bad and
+    /// the whole floor had to be searched again): the best member outside the `gate` becomes
+    /// the leader once a place there has cost at most [`CHALLENGE_RATIO`] of the leader's for
+    /// [`CHALLENGE_UPDATES`] updates in a row, moving with the odometry. Returns the leader.
+    fn challenge(&mut self, gate: &Gate, lead: usize) -> usize {
+        let p = &self.population;
+        let best = p.best();
+        if gate.contains(&p.poses[best]) || p.costs[best] > CHALLENGE_RATIO * p.costs[lead] {
+            self.challenger = None;
+            return lead;
+        }
+        let b = p.poses[best];
+        let here = Pose2::new(b[0], b[1], b[2]);
+        let same = |c: &Pose2| {
+            c.distance(&here) <= gate.radius && wrap_angle(c.theta - here.theta).abs() <= gate.angle
+        };
+        let wins = match self.challenger {
+            Some((c, n)) if same(&c) => n + 1,
+            _ => 1,
+        };
+        if wins >= CHALLENGE_UPDATES {
+            self.challenger = None;
+            best
+        } else {
+            self.challenger = Some((here, wins));
+            lead
+        }
+    }
+
+    /// Replaces the worst members (by their last cost) with poses drawn from the scan proposal,
+    /// poses that explain the scan's endpoints on the likelihood field.
+    fn inject_proposal(&mut self, map: &LocalizationMap, beams: &BeamSubset, n: usize) {
+        let laser = LaserModelParams::default();
+        let table = self.table.get_or_insert_with(|| {
+            Box::new(likelihood_table(&map.field, &laser, beams.range_max as f64))
+        });
+        let pool = scan_proposal(
+            map,
+            &laser,
+            table,
+            &beams.returns(),
+            beams.range_max,
+            n,
+            &mut self.rng,
+        );
+        let p = &mut self.population;
+        let mut order: Vec<usize> = (0..p.len()).collect();
+        order.sort_by(|&a, &b| p.costs[b].total_cmp(&p.costs[a]).then(a.cmp(&b)));
+        for (&i, &(x, y, th)) in order.iter().zip(&pool) {
+            p.poses[i] = [x, y, th];
+        }
+    }
+
     /// The motion half of [`DeTracker::update`]: false (nothing changed) unless this is the first
     /// scan or the odometry has moved enough since the last update; otherwise the population
     /// moves by the odometry since then.
@@ -116,9 +189,11 @@ impl DeTracker {
             let lead = self.population.leader(self.gate().as_ref());
             self.population.move_by(s.motion, &d, lead, &mut self.rng);
             // the estimate moves with the noise-free odometry
-            self.tracked = self
-                .tracked
-                .map(|t| t.compose(&last.inverse().compose(odom)));
+            let step = last.inverse().compose(odom);
+            self.tracked = self.tracked.map(|t| t.compose(&step));
+            if let Some((c, _)) = &mut self.challenger {
+                *c = c.compose(&step);
+            }
         }
         self.last_odom = Some(*odom);
         true
@@ -135,6 +210,9 @@ impl DeTracker {
     ) -> bool {
         if beams.is_empty() {
             return true;
+        }
+        if !self.converged && s.injection_candidates > 0 {
+            self.inject_proposal(map, beams, s.injection_candidates);
         }
         self.population.evaluate(map, beams, s.metric);
         self.evaluations += self.population.len() as u64;
@@ -155,7 +233,11 @@ impl DeTracker {
         );
         let elite = (self.population.poses[lead], self.population.costs[lead]);
         evolve(self, self.converged);
-        let lead = self.population.keep_elite(elite, self.gate().as_ref());
+        let gate = self.gate();
+        let mut lead = self.population.keep_elite(elite, gate.as_ref());
+        if let Some(g) = &gate {
+            lead = self.challenge(g, lead);
+        }
         let was_converged = self.converged;
         (self.converged, self.streak) = convergence(
             self.converged,
@@ -165,6 +247,9 @@ impl DeTracker {
             s.converge_updates,
         );
         self.updates += 1;
+        if !self.converged {
+            self.challenger = None;
+        }
         self.estimate = self.population.estimate(lead, 0.5, 0.2, ESTIMATE_FLOOR);
         self.tracked = self.estimate.map(|e| e.pose);
         if was_converged && !self.converged && s.reseed > 0 {
@@ -176,5 +261,52 @@ impl DeTracker {
             (self.population.poses[0], self.population.costs[0]) = best;
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+    use crate::localization::test_drive::hospital;
+
+    /// A converged tracker at (10, 7, 0) with one member there and one at a look-alike place
+    /// 27 m east, at the given costs.
+    fn converged_at(costs: [f64; 2]) -> DeTracker {
+        let map = hospital();
+        let mut t = DeTracker::new(2, &InitialBelief::Global, &map, stream_rng(1, "t", "de"));
+        t.population = Population {
+            poses: vec![[10.0, 7.0, 0.0], [37.0, 7.0, 0.0]],
+            costs: costs.to_vec(),
+        };
+        t.converged = true;
+        t.tracked = Some(Pose2::new(10.0, 7.0, 0.0));
+        t
+    }
+
+    /// The estimate moves to a place outside the gate only after that place has fitted clearly
+    /// better for `CHALLENGE_UPDATES` updates in a row; a marginally better fit never moves it.
+    #[test]
+    fn a_converged_tracker_moves_to_a_clearly_better_place_only_after_a_run_of_wins() {
+        let mut t = converged_at([0.05, 0.03]);
+        for update in 1..=CHALLENGE_UPDATES {
+            let gate = t.gate().expect("converged");
+            let lead = t.challenge(&gate, 0);
+            assert_eq!(lead == 1, update == CHALLENGE_UPDATES, "update {update}");
+        }
+        let mut t = converged_at([0.05, 0.045]);
+        for _ in 0..3 * CHALLENGE_UPDATES {
+            let gate = t.gate().expect("converged");
+            assert_eq!(t.challenge(&gate, 0), 0);
+        }
+        // a win at another place starts the count again
+        let mut t = converged_at([0.05, 0.03]);
+        for _ in 1..CHALLENGE_UPDATES {
+            let gate = t.gate().expect("converged");
+            assert_eq!(t.challenge(&gate, 0), 0);
+        }
+        t.population.poses[1] = [60.0, 24.7, 3.1];
+        let gate = t.gate().expect("converged");
+        assert_eq!(t.challenge(&gate, 0), 0);
     }
 }

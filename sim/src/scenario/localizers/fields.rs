@@ -64,6 +64,12 @@ impl Fields<'_> {
         Ok(v)
     }
 
+    /// `injection_candidates`: candidates per round of the scan proposal, 0 for none.
+    pub(super) fn injection_candidates(&self, default: usize) -> R<usize> {
+        let given = self.l.injection_candidates;
+        self.count("injection_candidates", given, default, 0, 10_000_000)
+    }
+
     pub(super) fn max_beams(&self, default: usize) -> R<usize> {
         match self.l.max_beams {
             Some(0) => self

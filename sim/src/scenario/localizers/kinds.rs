@@ -221,6 +221,7 @@ pub(super) fn resolve_de_filter(
             10_000,
         )?,
         refine_sd: d.refine_sd,
+        injection_candidates: f.injection_candidates(d.injection_candidates)?,
     })
 }
 
@@ -263,6 +264,7 @@ pub(super) fn resolve_de_mc(
             10_000,
         )?,
         refine_sd: d.refine_sd,
+        injection_candidates: f.injection_candidates(d.injection_candidates)?,
     })
 }
 

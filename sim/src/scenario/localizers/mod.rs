@@ -127,6 +127,7 @@ impl LocalizerType {
                 "converge_updates",
                 "refine_rounds",
                 "refine_samples",
+                "injection_candidates",
             ],
             LocalizerType::DeMc => &[
                 "max_beams",
@@ -147,6 +148,7 @@ impl LocalizerType {
                 "converge_updates",
                 "refine_rounds",
                 "refine_samples",
+                "injection_candidates",
             ],
             LocalizerType::DeOdometry => {
                 const KEYS: [&str; 10] = [
