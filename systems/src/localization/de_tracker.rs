@@ -12,7 +12,7 @@ use super::mcl::injection::scan_proposal;
 use super::mcl::sensor_model::likelihood_table;
 use super::mcl::{BeamSubset, InitialBelief, LaserModelParams, PoseEstimate};
 use super::motion_model::{OdometryMotionModel, moved_enough};
-use crate::core::{Pose2, SimRng, wrap_angle};
+use crate::core::{Pose2, SimRng};
 
 /// The settings of the shared cycle (fields of each method's configuration).
 #[derive(Clone, Copy, Debug)]
@@ -132,19 +132,19 @@ impl DeTracker {
             return lead;
         }
         let b = p.poses[best];
-        let here = Pose2::new(b[0], b[1], b[2]);
-        let same = |c: &Pose2| {
-            c.distance(&here) <= gate.radius && wrap_angle(c.theta - here.theta).abs() <= gate.angle
+        let near = |c: &Pose2| {
+            let centre = [c.x, c.y, c.theta];
+            Gate { centre, ..*gate }.contains(&b)
         };
         let wins = match self.challenger {
-            Some((c, n)) if same(&c) => n + 1,
+            Some((c, n)) if near(&c) => n + 1,
             _ => 1,
         };
         if wins >= CHALLENGE_UPDATES {
             self.challenger = None;
             best
         } else {
-            self.challenger = Some((here, wins));
+            self.challenger = Some((Pose2::new(b[0], b[1], b[2]), wins));
             lead
         }
     }
@@ -182,10 +182,7 @@ impl DeTracker {
                 return false;
             }
             let d = s.motion.delta(&last, odom);
-            self.step_sd = [
-                d.sd_trans.hypot(d.trans * d.sd_rot1),
-                d.sd_rot1.hypot(d.sd_rot2),
-            ];
+            self.step_sd = d.end_sd();
             let lead = self.population.leader(self.gate().as_ref());
             self.population.move_by(s.motion, &d, lead, &mut self.rng);
             // the estimate moves with the noise-free odometry

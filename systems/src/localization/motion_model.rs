@@ -53,6 +53,17 @@ pub struct OdometryDelta {
     pub sd_rot2: f64,
 }
 
+impl OdometryDelta {
+    /// The motion's spread at its end, to first order: position (m, from the translation's
+    /// noise and the first rotation's noise swung over the translation) and heading (rad).
+    pub fn end_sd(&self) -> [f64; 2] {
+        [
+            self.sd_trans.hypot(self.trans * self.sd_rot1),
+            self.sd_rot1.hypot(self.sd_rot2),
+        ]
+    }
+}
+
 /// |a| folded to [0, π/2]: a rotation of almost π is treated like a small one (reversing).
 fn folded(a: f64) -> f64 {
     let a = wrap_angle(a).abs();

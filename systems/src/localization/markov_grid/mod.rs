@@ -537,14 +537,12 @@ impl MarkovGrid {
     /// heading bin, widened by the motion model's noise for that motion.
     fn carried_estimate(&self) -> Option<refine::Prior> {
         let (e, from, to) = (self.estimate?, self.estimate_odom?, self.last_odom?);
-        let d = self.config.motion.delta(&from, &to);
+        let [sd_xy, sd_theta] = self.config.motion.delta(&from, &to).end_sd();
         let l = &self.layout;
-        let floor = |step: f64| (PRIOR_CELLS * step).powi(2);
         Some(refine::Prior {
             pose: e.pose.compose(&from.between(&to)),
-            sigma_xy: (floor(l.resolution) + d.sd_trans.powi(2) + (d.trans * d.sd_rot1).powi(2))
-                .sqrt(),
-            sigma_theta: (floor(l.theta_step()) + d.sd_rot1.powi(2) + d.sd_rot2.powi(2)).sqrt(),
+            sigma_xy: (PRIOR_CELLS * l.resolution).hypot(sd_xy),
+            sigma_theta: (PRIOR_CELLS * l.theta_step()).hypot(sd_theta),
         })
     }
 
