@@ -20,6 +20,7 @@ use systems::localization::de_filter::{DeFilter, DeFilterConfig};
 use systems::localization::fixtures::{
     CORRIDOR, DriveStep, bench_markov_grid, bench_mcl, hospital, recorded_drive,
 };
+use systems::localization::markov_grid::belief_ops;
 use systems::localization::mcl::field_kernel::{self, GridPose};
 use systems::localization::mcl::{BeamSubset, sensor_model};
 use systems::localization::{LocalizationMap, MarkovGrid};
@@ -197,7 +198,76 @@ fn cluster(c: &mut Criterion, map: &LocalizationMap) {
     g.finish();
 }
 
+/// The Markov grid's passes over a belief of the hospital's size (1.18 million cells), each
+/// against its plain version.
+fn belief_passes(c: &mut Criterion) {
+    let n = 256 * 128 * 36;
+    let v: Vec<f32> = (0..n)
+        .map(|i| {
+            if i % 5 == 0 {
+                0.0
+            } else {
+                1e-7 * ((i % 97) as f32 + 1.0)
+            }
+        })
+        .collect();
+    let mut out = v.clone();
+    let mut g = c.benchmark_group("markov_grid_pass");
+    g.bench_function("sum", |b| b.iter(|| black_box(belief_ops::sum(&v))));
+    g.bench_function("sum_plain", |b| {
+        b.iter(|| black_box(belief_ops::sum_plain(&v)))
+    });
+    g.bench_function("peak", |b| b.iter(|| black_box(belief_ops::peak(&v))));
+    g.bench_function("peak_plain", |b| {
+        b.iter(|| black_box(belief_ops::peak_plain(&v)))
+    });
+    g.bench_function("copy", |b| {
+        b.iter(|| {
+            let mut t = belief_ops::Tally::default();
+            belief_ops::copy(&mut out, &v, &mut t);
+            black_box(t.sum())
+        })
+    });
+    g.bench_function("scale", |b| {
+        b.iter(|| {
+            let mut t = belief_ops::Tally::default();
+            belief_ops::scale(&mut out, 1.0, &mut t);
+            black_box(t.sum())
+        })
+    });
+    g.bench_function("scale_below", |b| {
+        b.iter(|| {
+            let mut t = belief_ops::Tally::default();
+            belief_ops::scale_below(&mut out, 5e-6, 1.0, &mut t);
+            black_box(t.sum())
+        })
+    });
+    g.bench_function("scale_and_mix", |b| {
+        b.iter(|| {
+            let mut t = belief_ops::Tally::default();
+            belief_ops::scale_and_mix(&mut out, 1.0, 1.0, 0.0, &mut t);
+            black_box(t.peak())
+        })
+    });
+    g.bench_function("find", |b| {
+        let top = belief_ops::peak(&v);
+        b.iter(|| black_box(belief_ops::find(&v, top)))
+    });
+    g.bench_function("argmax", |b| b.iter(|| black_box(belief_ops::argmax(&v))));
+    g.bench_function("runs_at_or_above", |b| {
+        b.iter(|| {
+            let mut n = 0;
+            for row in v.chunks(256) {
+                belief_ops::runs_at_or_above(row, 9e-6, |_, l| n += l);
+            }
+            black_box(n)
+        })
+    });
+    g.finish();
+}
+
 fn localization(c: &mut Criterion) {
+    belief_passes(c);
     let map = hospital();
     let steps = recorded_drive(&map, &CORRIDOR, 0.0, 1);
     let beams = subsets(&steps);

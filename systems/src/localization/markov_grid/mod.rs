@@ -24,6 +24,7 @@
 //! Like MCL, it updates only after a minimum travel or turn of the odometry. Layers (θ) are
 //! scored in parallel; each layer's result depends on that layer only.
 
+pub mod belief_ops;
 pub mod correction;
 pub mod layout;
 pub mod prediction;
@@ -97,6 +98,9 @@ pub struct MarkovGrid {
     pub sub_cell: SubCell,
     /// Motion noise not yet blurred in: position (cells²) and heading (bins²) variance.
     pending_noise: [f64; 2],
+    /// The belief's largest value, when the pass that last wrote it tallied it (the
+    /// normalisation after a motion): the selective update's threshold without a pass of its own.
+    peak: Option<f32>,
     scratch: Vec<f32>,
     tmp: Vec<f32>,
     field: Option<PaddedField>,
@@ -155,18 +159,6 @@ const TRACKING_CELLS: f64 = 2.0;
 /// the estimate slid ahead along the hospital's corridors on single scans.
 const PRIOR_CELLS: f64 = 0.2;
 
-/// The largest value by [`f32::total_cmp`] and its index, the first of equals: a maximum of
-/// integer keys (`total_cmp`'s own), which vectorises, then the first key equal to it.
-fn argmax(v: &[f32]) -> Option<(usize, f32)> {
-    let key = |x: f32| {
-        let b = x.to_bits() as i32;
-        b ^ (((b >> 31) as u32) >> 1) as i32
-    };
-    let top = v.iter().map(|&x| key(x)).max()?;
-    let i = v.iter().position(|&x| key(x) == top)?;
-    Some((i, v[i]))
-}
-
 /// The endpoints of `points` a cell can see: finite and within the map's diagonal. Borrowed
 /// when that is all of them (a scan of the map always is).
 fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32; 2]]> {
@@ -180,6 +172,11 @@ fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32
     }
 }
 
+/// The factor that scales a belief summing to `total` to sum 1, if it holds mass.
+fn normaliser(total: f64) -> Option<f32> {
+    (total > 0.0 && total.is_finite()).then(|| (1.0 / total) as f32)
+}
+
 /// A cell centre `(x, y, heading offset, belief)` in the estimate's neighbourhood.
 type WeightedCell = (f64, f64, f64, f64);
 
@@ -190,6 +187,7 @@ impl MarkovGrid {
             belief: vec![0.0; layout.len()],
             sub_cell: SubCell::centred(&layout),
             pending_noise: [0.0; 2],
+            peak: None,
             scratch: vec![0.0; layout.len()],
             tmp: Vec::new(),
             sample: sample_cells(&layout),
@@ -235,6 +233,7 @@ impl MarkovGrid {
     }
 
     fn fill_uniform(&mut self) {
+        self.peak = None;
         let l = &self.layout;
         let n = (l.free_count() * l.n_theta).max(1) as f32;
         self.belief.iter_mut().for_each(|v| *v = 0.0);
@@ -250,12 +249,19 @@ impl MarkovGrid {
 
     /// Scales the belief to sum 1; false if it holds no mass.
     fn normalise(&mut self) -> bool {
-        let total: f64 = self.belief.iter().map(|&v| v as f64).sum();
-        if !(total > 0.0 && total.is_finite()) {
+        self.normalise_sum(belief_ops::sum(&self.belief))
+    }
+
+    /// Scales the belief, which sums to `total`, to sum 1 and keeps its largest value; false
+    /// if it holds no mass.
+    fn normalise_sum(&mut self, total: f64) -> bool {
+        self.peak = None;
+        let Some(s) = normaliser(total) else {
             return false;
-        }
-        let s = (1.0 / total) as f32;
-        self.belief.iter_mut().for_each(|v| *v *= s);
+        };
+        let mut t = belief_ops::Tally::default();
+        belief_ops::scale(&mut self.belief, s, &mut t);
+        self.peak = Some(t.peak());
         true
     }
 
@@ -263,7 +269,8 @@ impl MarkovGrid {
     pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
         let l = &self.layout;
-        prediction::shift(l, &d, &mut self.sub_cell, &self.belief, &mut self.scratch);
+        let mut total =
+            prediction::shift(l, &d, &mut self.sub_cell, &self.belief, &mut self.scratch);
         std::mem::swap(&mut self.belief, &mut self.scratch);
         // a blur as wide as the grid already spreads the mass over all of it: capped there, so
         // a jump of the odometry does not ask for a kernel as long as the jump
@@ -276,14 +283,16 @@ impl MarkovGrid {
             let k = prediction::kernel_of_variance(self.pending_noise[0]);
             prediction::blur_xy(&self.layout, &k, &mut self.belief, &mut self.tmp);
             self.pending_noise[0] = 0.0;
+            total = belief_ops::sum(&self.belief);
         }
         if self.pending_noise[1] >= BLUR_VARIANCE {
             let k = prediction::kernel_of_variance(self.pending_noise[1]);
             prediction::blur_theta(&self.layout, &k, &self.belief, &mut self.scratch);
             std::mem::swap(&mut self.belief, &mut self.scratch);
             self.pending_noise[1] = 0.0;
+            total = belief_ops::sum(&self.belief);
         }
-        if !self.normalise() {
+        if !self.normalise_sum(total) {
             self.fill_uniform();
         }
     }
@@ -369,23 +378,14 @@ impl MarkovGrid {
             .map(|b| {
                 let mut out = Vec::new();
                 for s in &l.spans {
-                    let row = s.j as usize * l.nx;
-                    let mut start: Option<u32> = None;
-                    for i in s.i0..=s.i0 + s.len {
-                        let on = i < s.i0 + s.len && b[row + i as usize] >= threshold;
-                        match (on, start) {
-                            (true, None) => start = Some(i),
-                            (false, Some(i0)) => {
-                                out.push(Span {
-                                    j: s.j,
-                                    i0,
-                                    len: i - i0,
-                                });
-                                start = None;
-                            }
-                            _ => {}
-                        }
-                    }
+                    let a = s.j as usize * l.nx + s.i0 as usize;
+                    belief_ops::runs_at_or_above(&b[a..a + s.len as usize], threshold, |i, n| {
+                        out.push(Span {
+                            j: s.j,
+                            i0: s.i0 + i as u32,
+                            len: n as u32,
+                        })
+                    });
                 }
                 out
             })
@@ -398,22 +398,37 @@ impl MarkovGrid {
     /// Endpoints that are not finite, or farther than the map's diagonal (outside the map seen
     /// from every cell, so they weigh every cell alike), are left out.
     pub fn apply_scan(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+        self.weigh(map, points, range_max);
+    }
+
+    /// [`MarkovGrid::apply_scan`], returning where the corrected belief is largest (the first
+    /// such cell) if its last pass found it.
+    fn weigh(
+        &mut self,
+        map: &LocalizationMap,
+        points: &[[f32; 2]],
+        range_max: f32,
+    ) -> Option<usize> {
         let points = reachable(map, points);
         let points = &points[..];
         if points.is_empty() {
-            return;
+            return None;
         }
         let lambda = self.config.likelihood_exponent as f32;
         // selective update only when it skips at least half of the cells
         let cells = self.layout.free_count() * self.layout.n_theta;
-        let peak = self.belief.iter().copied().fold(0.0f32, f32::max);
+        let peak = match self.peak.take() {
+            Some(p) => p,
+            None => belief_ops::peak(&self.belief),
+        };
         let threshold = (self.config.selective_threshold as f32 * peak).max(f32::MIN_POSITIVE);
         let selective = (self.config.selective_threshold > 0.0)
             .then(|| self.active_runs(threshold))
             .filter(|(_, n)| 2 * n < cells);
         let sampled = self.score(map, points, range_max, selective.as_ref().map(|a| &a.0[..]));
         let l = &self.layout;
-        match selective {
+        // the belief's sum after the weighing, tallied by it where it passes over every cell
+        let total = match selective {
             None => {
                 let best = self
                     .belief
@@ -429,6 +444,7 @@ impl MarkovGrid {
                         }
                     }
                 }
+                belief_ops::sum(&self.belief)
             }
             Some((runs, _)) => {
                 let layer = l.layer();
@@ -448,33 +464,63 @@ impl MarkovGrid {
                         .map(|&v| (lambda * (v - best)).exp() as f64)
                         .sum::<f64>()
                         / sampled.len().max(1) as f64;
-                    let floor = floor as f32;
-                    for (p, &l) in self.belief.iter_mut().zip(&self.scratch) {
-                        if *p >= threshold {
-                            *p *= (lambda * (l - best)).exp();
-                        } else if *p > 0.0 {
-                            *p *= floor;
+                    // the cells not scored first, then the scored runs: those are the cells at
+                    // or above the threshold, which the first pass leaves as they are
+                    let mut all = belief_ops::Tally::default();
+                    belief_ops::scale_below(&mut self.belief, threshold, floor as f32, &mut all);
+                    // the sum: the tally's, with the scored cells' weighed values for their own
+                    let (mut unweighed, mut weighed) = (0.0f64, 0.0f64);
+                    for (k, rs) in runs.iter().enumerate() {
+                        for r in rs {
+                            let a = k * layer + r.j as usize * l.nx + r.i0 as usize;
+                            let cells = a..a + r.len as usize;
+                            for (p, &v) in self.belief[cells.clone()]
+                                .iter_mut()
+                                .zip(&self.scratch[cells])
+                            {
+                                unweighed += *p as f64;
+                                *p *= (lambda * (v - best)).exp();
+                                weighed += *p as f64;
+                            }
                         }
                     }
+                    all.sum() - unweighed + weighed
+                } else {
+                    belief_ops::sum(&self.belief)
                 }
             }
-        }
-        if !self.normalise() {
-            self.fill_uniform();
-        }
+        };
+        // normalised and mixed with the uniform share in one pass over the free cells, which
+        // also finds the most probable cell
+        let s = match normaliser(total) {
+            Some(s) => s,
+            None => {
+                self.fill_uniform();
+                1.0
+            }
+        };
         let mix = self.config.uniform_mix as f32;
+        let l = &self.layout;
+        let u = mix / (l.free_count() * l.n_theta).max(1) as f32;
+        let mut t = belief_ops::Tally::default();
         if mix > 0.0 {
-            let l = &self.layout;
-            let u = mix / (l.free_count() * l.n_theta).max(1) as f32;
             for k in 0..l.n_theta {
-                for s in &l.spans {
-                    let a = k * l.layer() + s.j as usize * l.nx + s.i0 as usize;
-                    self.belief[a..a + s.len as usize]
-                        .iter_mut()
-                        .for_each(|v| *v = (1.0 - mix) * *v + u);
+                for sp in &l.spans {
+                    let a = k * l.layer() + sp.j as usize * l.nx + sp.i0 as usize;
+                    let cells = &mut self.belief[a..a + sp.len as usize];
+                    belief_ops::scale_and_mix(cells, s, 1.0 - mix, u, &mut t);
                 }
             }
+        } else {
+            belief_ops::scale(&mut self.belief, s, &mut t);
         }
+        // the most probable cell is the first holding the largest value (for positive, finite
+        // values, the first maximum in total_cmp's order)
+        let peak = t.peak();
+        self.peak = Some(peak);
+        (peak > 0.0)
+            .then(|| belief_ops::find(&self.belief, peak))
+            .flatten()
     }
 
     /// Consumes a scan (endpoints in the base frame) taken at odometry pose `odom`. Returns true
@@ -498,11 +544,15 @@ impl MarkovGrid {
     ) -> bool {
         let points = reachable(map, points);
         let points = &points[..];
-        self.apply_scan(map, points, range_max);
+        let best = self.weigh(map, points, range_max);
         self.updates += 1;
         let carried = self.carried_estimate();
         let l = &self.layout;
-        self.estimate = self.estimate_pose().map(|mut e| {
+        let histogram = match best {
+            Some(i) => self.estimate_at(i),
+            None => self.estimate_pose(),
+        };
+        self.estimate = histogram.map(|mut e| {
             // tracking: the last estimate moved by the odometry, where the histogram agrees
             // with it, searched within half a cell; otherwise the histogram's own estimate
             // within a cell
@@ -548,9 +598,13 @@ impl MarkovGrid {
 
     /// The most probable cell, refined over its 3 × 3 × 3 neighbourhood.
     pub fn estimate_pose(&self) -> Option<PoseEstimate> {
+        self.estimate_at(belief_ops::argmax(&self.belief)?.0)
+    }
+
+    /// Cell `best` refined over its 3 × 3 × 3 neighbourhood, if it holds mass.
+    fn estimate_at(&self, best: usize) -> Option<PoseEstimate> {
         let l = &self.layout;
-        let (best, p) = argmax(&self.belief)?;
-        if p <= 0.0 {
+        if self.belief[best] <= 0.0 {
             return None;
         }
         let layer = l.layer();

@@ -14,6 +14,7 @@
 //! odometry's own variance, and along a corridor, where a scan says little about the position
 //! along it, the histogram drifted away from the robot by half a metre.
 
+use super::belief_ops::{Tally, copy};
 use super::layout::Layout;
 use crate::localization::motion_model::OdometryDelta;
 
@@ -54,55 +55,90 @@ impl SubCell {
     }
 }
 
-/// Moves `src` (all θ layers, at the offsets `sub`) by `d` into `dst` (cleared first), and
-/// `sub` to the offsets of the moved mass.
-pub fn shift(layout: &Layout, d: &OdometryDelta, sub: &mut SubCell, src: &[f32], dst: &mut [f32]) {
-    dst.iter_mut().for_each(|v| *v = 0.0);
-    let (nx, ny, nt) = (layout.nx as isize, layout.ny as isize, layout.n_theta);
+/// Moves `src` (all θ layers, at the offsets `sub`) by `d` into `dst`, and `sub` to the offsets
+/// of the moved mass. Every free cell of `dst` is written: the mass from its source cell if that
+/// lies in the grid, 0 otherwise (mass that leaves the grid or lands on an occupied or unknown
+/// cell is dropped). Neither `src` nor `dst` holds anything outside free space. Returns the sum
+/// of `dst`.
+pub fn shift(
+    layout: &Layout,
+    d: &OdometryDelta,
+    sub: &mut SubCell,
+    src: &[f32],
+    dst: &mut [f32],
+) -> f64 {
+    let (moves, turn) = layer_moves(layout, d, sub);
+    let (nx, ny) = (layout.nx as isize, layout.ny as isize);
     let layer = layout.layer();
-    // heading change in bins, the same for every layer: whole bins, the rest carried
+    let mut tally = Tally::default();
+    for (k, m) in moves.iter().enumerate() {
+        let from = &src[k * layer..(k + 1) * layer];
+        let into = &mut dst[m.to * layer..(m.to + 1) * layer];
+        for s in &layout.spans {
+            let cells = &mut into[s.j as usize * layout.nx..][s.i0 as usize..][..s.len as usize];
+            let j = s.j as isize - m.iy;
+            // the span's columns whose source column lies in the grid
+            let (i0, i1) = (s.i0 as isize, (s.i0 + s.len) as isize);
+            let (a, b) = ((i0 - m.ix).max(0) + m.ix, (i1 - m.ix).min(nx) + m.ix);
+            if j < 0 || j >= ny || a >= b {
+                cells.fill(0.0);
+                continue;
+            }
+            let (a, b) = ((a - i0) as usize, (b - i0) as usize);
+            let source = &from[j as usize * layout.nx..];
+            let first = (i0 + a as isize - m.ix) as usize;
+            cells[..a].fill(0.0);
+            cells[b..].fill(0.0);
+            copy(
+                &mut cells[a..b],
+                &source[first..first + (b - a)],
+                &mut tally,
+            );
+        }
+    }
+    for m in &moves {
+        sub.xy[m.to] = m.rest;
+    }
+    sub.theta = turn;
+    tally.sum()
+}
+
+/// Where one θ layer's mass goes: layer `to`, by `ix`, `iy` whole cells, leaving `rest` (cells,
+/// each within ±½) as the moved mass's offset.
+pub struct LayerMove {
+    pub to: usize,
+    pub ix: isize,
+    pub iy: isize,
+    pub rest: [f64; 2],
+}
+
+/// Every layer's move under the motion `d`, and the heading offset (bins) left over for all
+/// layers: each layer moves by its offset plus the motion as seen from its heading, rounded to
+/// whole cells, and all turn by the same whole bins. A move past the grid's extent drops all
+/// the mass, as any longer one: clamped there so the cell arithmetic stays within integers.
+pub fn layer_moves(layout: &Layout, d: &OdometryDelta, sub: &SubCell) -> (Vec<LayerMove>, f64) {
+    let nt = layout.n_theta as isize;
     let turn = sub.theta + (d.rot1 + d.rot2) / layout.theta_step();
     let dk = turn.round();
-    // a shift past the grid's extent drops all the mass, as any longer one: clamped there so
-    // the cell arithmetic stays within integers
     let beyond = (layout.nx + layout.ny + 2) as f64;
-    let mut moved = vec![[0.0; 2]; nt];
-    for (k, sub_k) in sub.xy.iter().enumerate() {
-        let th = sub.heading(layout, k) + d.rot1;
-        let sx = (sub_k[0] + d.trans * th.cos() / layout.resolution).clamp(-beyond, beyond);
-        let sy = (sub_k[1] + d.trans * th.sin() / layout.resolution).clamp(-beyond, beyond);
-        let (ix, iy) = (sx.round(), sy.round());
-        let to = (k as isize + dk as isize).rem_euclid(nt as isize) as usize;
-        moved[to] = [sx - ix, sy - iy];
-        let (ix, iy) = (ix as isize, iy as isize);
-        let from = &src[k * layer..(k + 1) * layer];
-        let into = &mut dst[to * layer..(to + 1) * layer];
-        // the whole layer moves by the same (ix, iy): contiguous row slices; mass that lands
-        // on a cell outside free space is dropped below
-        for s in &layout.spans {
-            let tj = s.j as isize + iy;
-            if tj < 0 || tj >= ny {
-                continue;
+    let moves = sub
+        .xy
+        .iter()
+        .enumerate()
+        .map(|(k, &[ox, oy])| {
+            let th = sub.heading(layout, k) + d.rot1;
+            let sx = (ox + d.trans * th.cos() / layout.resolution).clamp(-beyond, beyond);
+            let sy = (oy + d.trans * th.sin() / layout.resolution).clamp(-beyond, beyond);
+            let (ix, iy) = (sx.round(), sy.round());
+            LayerMove {
+                to: (k as isize + dk as isize).rem_euclid(nt) as usize,
+                ix: ix as isize,
+                iy: iy as isize,
+                rest: [sx - ix, sy - iy],
             }
-            let (i0, i1) = (s.i0 as isize, (s.i0 + s.len) as isize);
-            let (a, b) = ((i0 + ix).max(0), (i1 + ix).min(nx));
-            if a >= b {
-                continue;
-            }
-            let j = s.j as isize;
-            into[(tj * nx + a) as usize..(tj * nx + b) as usize]
-                .copy_from_slice(&from[(j * nx + a - ix) as usize..(j * nx + b - ix) as usize]);
-        }
-    }
-    sub.xy = moved;
-    sub.theta = turn - dk;
-    for layer_cells in dst.chunks_mut(layer) {
-        for (v, &f) in layer_cells.iter_mut().zip(&layout.free) {
-            if !f {
-                *v = 0.0;
-            }
-        }
-    }
+        })
+        .collect();
+    (moves, turn - dk)
 }
 
 /// A normalised blur kernel of variance `var` (cells²): for less than half a cell², the
@@ -186,6 +222,97 @@ pub fn blur_theta(layout: &Layout, k: &[f32], p: &[f32], dst: &mut [f32]) {
                 for (o, &v) in dst[out + a..out + b].iter_mut().zip(&p[s + a..s + b]) {
                     *o += w * v;
                 }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::{Pose2, stream_rng};
+    use crate::localization::motion_model::OdometryMotionModel;
+    use crate::localization::test_drive::hospital;
+    use rand::RngExt;
+
+    /// The shift as first written: clear the target, copy each free run of a layer to its moved
+    /// place, then clear the cells that are not free.
+    fn shift_plain(l: &Layout, d: &OdometryDelta, sub: &mut SubCell, src: &[f32], dst: &mut [f32]) {
+        dst.fill(0.0);
+        let (moves, turn) = layer_moves(l, d, sub);
+        let (nx, ny, layer) = (l.nx as isize, l.ny as isize, l.layer());
+        for (k, m) in moves.iter().enumerate() {
+            for s in &l.spans {
+                let tj = s.j as isize + m.iy;
+                let (a, b) = (
+                    (s.i0 as isize + m.ix).max(0),
+                    ((s.i0 + s.len) as isize + m.ix).min(nx),
+                );
+                if tj < 0 || tj >= ny || a >= b {
+                    continue;
+                }
+                let (t, f) = (m.to * layer, k * layer + s.j as usize * l.nx);
+                dst[t + (tj * nx + a) as usize..t + (tj * nx + b) as usize]
+                    .copy_from_slice(&src[f + (a - m.ix) as usize..f + (b - m.ix) as usize]);
+            }
+        }
+        for (c, v) in dst.iter_mut().enumerate() {
+            if !l.free[c % layer] {
+                *v = 0.0;
+            }
+        }
+        for m in &moves {
+            sub.xy[m.to] = m.rest;
+        }
+        sub.theta = turn;
+    }
+
+    /// The shift writes what the plain one does, whatever the target's free cells held, for
+    /// small steps, turns, long jumps and jumps off the grid.
+    #[test]
+    fn shift_equals_the_plain_shift() {
+        let map = hospital();
+        let l = Layout::new(&map.grid, 0.25, 36);
+        let mut rng = stream_rng(3, "test", "shift");
+        let mut src = vec![0.0f32; l.len()];
+        for layer in src.chunks_mut(l.layer()) {
+            for (v, &f) in layer.iter_mut().zip(&l.free) {
+                if f {
+                    *v = rng.random_range(0.0..1.0);
+                }
+            }
+        }
+        let model = OdometryMotionModel::default();
+        let mut sub = SubCell::centred(&l);
+        for (x, y, th) in [
+            (0.25, 0.0, 0.0),
+            (0.1, -0.3, 0.2),
+            (-0.6, 0.4, -1.0),
+            (3.0, 2.0, 3.0),
+            (-20.0, 7.0, 0.5),
+            (100.0, -100.0, 0.0),
+        ] {
+            let d = model.delta(&Pose2::IDENTITY, &Pose2::new(x, y, th));
+            // the target's free cells hold stale values, the others nothing
+            let mut fast: Vec<f32> = (0..l.len())
+                .map(|c| if l.free[c % l.layer()] { 7.0 } else { 0.0 })
+                .collect();
+            let mut plain = vec![0.0f32; l.len()];
+            let (mut sub_fast, mut sub_plain) = (sub.clone(), sub.clone());
+            let total = shift(&l, &d, &mut sub_fast, &src, &mut fast);
+            shift_plain(&l, &d, &mut sub_plain, &src, &mut plain);
+            assert!(
+                fast.iter()
+                    .zip(&plain)
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            );
+            assert_eq!(sub_fast, sub_plain);
+            let plain_total: f64 = plain.iter().map(|&v| v as f64).sum();
+            assert!((total - plain_total).abs() <= 1e-12 * plain_total);
+            sub = sub_fast;
+            src = fast;
+            if src.iter().all(|&v| v == 0.0) {
+                break;
             }
         }
     }

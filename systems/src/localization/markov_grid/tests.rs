@@ -298,7 +298,7 @@ fn argmax_is_total_cmp_s_first_maximum() {
                     }
                 })
                 .collect();
-            let fast = argmax(&v).map(|(i, x)| (i, x.to_bits()));
+            let fast = belief_ops::argmax(&v).map(|(i, x)| (i, x.to_bits()));
             assert_eq!(fast, plain(&v), "{v:?}");
         }
     }

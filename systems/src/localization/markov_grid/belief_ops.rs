@@ -1,0 +1,341 @@
+//! Passes over the whole belief (about a million cells at the default 0.25 m × 10° on a
+//! 64 × 32 m floor), run at every update, written so that they vectorise: each keeps
+//! [`LANES`] independent partial results instead of one chain of dependent operations, which a
+//! compiler may not reorder for floating point. Each has its plain version beside it, which the
+//! tests hold it to.
+
+/// Independent partial results per pass.
+pub const LANES: usize = 8;
+
+/// The sum (f64) and the largest value (and 0, NaN ignored) of the values a pass has written,
+/// in [`LANES`] partial results: a pass that writes the belief tallies it on the way, so the
+/// normalisation and the selective update's threshold need no pass of their own.
+#[derive(Clone, Copy, Debug)]
+pub struct Tally {
+    sum: [f64; LANES],
+    max: [f32; LANES],
+}
+
+impl Default for Tally {
+    fn default() -> Self {
+        Tally {
+            sum: [0.0; LANES],
+            max: [0.0; LANES],
+        }
+    }
+}
+
+impl Tally {
+    /// Adds a block of at most [`LANES`] values.
+    #[inline(always)]
+    fn block(&mut self, b: &[f32]) {
+        for (lane, &x) in b.iter().enumerate() {
+            self.lane(lane, x);
+        }
+    }
+
+    /// Adds `x` to lane `lane`.
+    #[inline(always)]
+    fn lane(&mut self, lane: usize, x: f32) {
+        self.sum[lane] += x as f64;
+        self.max[lane] = if x > self.max[lane] {
+            x
+        } else {
+            self.max[lane]
+        };
+    }
+
+    pub fn add(&mut self, v: &[f32]) {
+        let (blocks, rest) = v.as_chunks::<LANES>();
+        for b in blocks {
+            self.block(b);
+        }
+        self.block(rest);
+    }
+
+    /// The partial sums added pairwise: equal to the plain sum up to rounding (a relative 1e-12
+    /// on a million non-negative cells).
+    pub fn sum(&self) -> f64 {
+        let mut acc = self.sum;
+        let mut w = LANES;
+        while w > 1 {
+            w /= 2;
+            for i in 0..w {
+                acc[i] += acc[i + w];
+            }
+        }
+        acc[0]
+    }
+
+    /// The largest value: exactly the plain one.
+    pub fn peak(&self) -> f32 {
+        self.max
+            .iter()
+            .fold(0.0f32, |a, &x| if x > a { x } else { a })
+    }
+}
+
+/// The sum in f64 of `v`, tallied.
+pub fn sum(v: &[f32]) -> f64 {
+    let mut t = Tally::default();
+    t.add(v);
+    t.sum()
+}
+
+/// The sum in f64 of `v`, element after element.
+pub fn sum_plain(v: &[f32]) -> f64 {
+    v.iter().map(|&x| x as f64).sum()
+}
+
+/// The largest value of `v` and 0, NaN ignored, tallied: exactly [`peak_plain`].
+pub fn peak(v: &[f32]) -> f32 {
+    let mut t = Tally::default();
+    t.add(v);
+    t.peak()
+}
+
+/// The largest value of `v` and 0, NaN ignored, element after element.
+pub fn peak_plain(v: &[f32]) -> f32 {
+    v.iter().copied().fold(0.0f32, f32::max)
+}
+
+/// Cells [`runs_at_or_above`] tests at once.
+const RUN_BLOCK: usize = 32;
+
+/// Calls `emit(start, len)` for every maximal run of `row` at or above `threshold`, in order:
+/// exactly [`runs_at_or_above_plain`]. Blocks of [`RUN_BLOCK`] wholly below or wholly above the
+/// threshold (nearly all of them once the belief has converged) are passed in one test.
+pub fn runs_at_or_above(row: &[f32], threshold: f32, mut emit: impl FnMut(usize, usize)) {
+    let mut start: Option<usize> = None;
+    for (b, block) in row.chunks(RUN_BLOCK).enumerate() {
+        let at = b * RUN_BLOCK;
+        let above = block
+            .iter()
+            .fold(0usize, |n, &x| n + usize::from(x >= threshold));
+        if above == 0 {
+            if let Some(s) = start.take() {
+                emit(s, at - s);
+            }
+        } else if above == block.len() {
+            start.get_or_insert(at);
+        } else {
+            for (i, &x) in block.iter().enumerate() {
+                match (x >= threshold, start) {
+                    (true, None) => start = Some(at + i),
+                    (false, Some(s)) => {
+                        emit(s, at + i - s);
+                        start = None;
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+    if let Some(s) = start {
+        emit(s, row.len() - s);
+    }
+}
+
+/// [`runs_at_or_above`], element after element.
+pub fn runs_at_or_above_plain(row: &[f32], threshold: f32, mut emit: impl FnMut(usize, usize)) {
+    let mut start: Option<usize> = None;
+    for (i, &x) in row.iter().enumerate() {
+        match (x >= threshold, start) {
+            (true, None) => start = Some(i),
+            (false, Some(s)) => {
+                emit(s, i - s);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some(s) = start {
+        emit(s, row.len() - s);
+    }
+}
+
+/// Each value `x` of `v` becomes `f(x)`, tallied: blocks of [`LANES`], one value per lane.
+#[inline(always)]
+fn map_tallied(v: &mut [f32], t: &mut Tally, f: impl Fn(f32) -> f32) {
+    let (blocks, rest) = v.as_chunks_mut::<LANES>();
+    for b in blocks {
+        for (lane, x) in b.iter_mut().enumerate() {
+            let y = f(*x);
+            *x = y;
+            t.lane(lane, y);
+        }
+    }
+    for (lane, x) in rest.iter_mut().enumerate() {
+        let y = f(*x);
+        *x = y;
+        t.lane(lane, y);
+    }
+}
+
+/// Multiplies every value of `v` below `threshold` by `factor` (the selective update's weight of
+/// the cells it does not score), tallying the results; values at or above it, and NaN, are left
+/// as they are.
+pub fn scale_below(v: &mut [f32], threshold: f32, factor: f32, t: &mut Tally) {
+    // a factor of 1 leaves a value as it is, NaN included
+    map_tallied(v, t, |x| x * if x < threshold { factor } else { 1.0 });
+}
+
+/// Multiplies every value of `v` by `factor`, tallying the results.
+pub fn scale(v: &mut [f32], factor: f32, t: &mut Tally) {
+    map_tallied(v, t, |x| x * factor);
+}
+
+/// Each value `x` of `v` becomes `keep · (x · factor) + add`, tallied: a normalisation and a
+/// uniform mix in one pass, rounded as the two passes one after the other would be.
+pub fn scale_and_mix(v: &mut [f32], factor: f32, keep: f32, add: f32, t: &mut Tally) {
+    map_tallied(v, t, |x| keep * (x * factor) + add);
+}
+
+/// Copies `src` into `dst` (as much as both hold), tallying it.
+pub fn copy(dst: &mut [f32], src: &[f32], t: &mut Tally) {
+    let n = dst.len().min(src.len());
+    dst[..n].copy_from_slice(&src[..n]);
+    t.add(&dst[..n]);
+}
+
+/// [`f32::total_cmp`]'s order as integers.
+fn order_key(x: f32) -> i32 {
+    let b = x.to_bits() as i32;
+    b ^ (((b >> 31) as u32) >> 1) as i32
+}
+
+/// The first place of `value` in `v` (bit for bit), if any: a block of [`LANES`] at a time.
+pub fn find(v: &[f32], value: f32) -> Option<usize> {
+    let bits = value.to_bits();
+    let b = v
+        .chunks(LANES)
+        .position(|c| c.iter().fold(false, |f, &x| f | (x.to_bits() == bits)))?;
+    Some(b * LANES + v[b * LANES..].iter().position(|&x| x.to_bits() == bits)?)
+}
+
+/// The index and value of the largest value of `v` by [`f32::total_cmp`], the first of equals:
+/// the largest key (vectorised), then the first block and the first cell holding it (held to
+/// `max_by` with `total_cmp` in the Markov grid's tests).
+pub fn argmax(v: &[f32]) -> Option<(usize, f32)> {
+    let top = v.iter().map(|&x| order_key(x)).max()?;
+    let b = v
+        .chunks(LANES)
+        .position(|c| c.iter().fold(false, |f, &x| f | (order_key(x) == top)))?;
+    let i = b * LANES + v[b * LANES..].iter().position(|&x| order_key(x) == top)?;
+    Some((i, v[i]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+    use rand::RngExt;
+
+    /// A belief-like vector: mostly tiny values, a few large ones, runs of zeros (walls),
+    /// and a length that is not a multiple of the lanes.
+    fn belief(seed: u64, n: usize) -> Vec<f32> {
+        let mut rng = stream_rng(seed, "test", "belief-ops");
+        (0..n)
+            .map(|i| match rng.random_range(0..10) {
+                0 => 0.0,
+                1 => rng.random_range(0.0..1.0),
+                _ if (i / 40) % 7 == 3 => rng.random_range(0.5..1.0),
+                _ => rng.random_range(0.0..1e-9),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_vectorised_passes_equal_the_plain_ones() {
+        for (seed, n) in [
+            (1, 0),
+            (2, 1),
+            (3, 15),
+            (4, 16),
+            (5, 17),
+            (6, 1000),
+            (7, 100_003),
+        ] {
+            let v = belief(seed, n);
+            let (a, b) = (sum(&v), sum_plain(&v));
+            assert!((a - b).abs() <= 1e-12 * b.abs(), "sum {a} against {b}");
+            assert_eq!(peak(&v).to_bits(), peak_plain(&v).to_bits());
+            for threshold in [1e-10, 0.4, 0.75, 2.0] {
+                let (mut fast, mut plain) = (Vec::new(), Vec::new());
+                runs_at_or_above(&v, threshold, |s, l| fast.push((s, l)));
+                runs_at_or_above_plain(&v, threshold, |s, l| plain.push((s, l)));
+                assert_eq!(fast, plain, "n {n}, threshold {threshold}");
+            }
+        }
+    }
+
+    #[test]
+    fn argmax_finds_the_first_of_equal_maxima_across_blocks() {
+        let mut v = vec![0.25f32; 100];
+        v[37] = 0.5;
+        v[90] = 0.5;
+        assert_eq!(argmax(&v), Some((37, 0.5)));
+        assert_eq!(argmax(&[]), None);
+        // a NaN orders above every number under total_cmp
+        v[50] = f32::NAN;
+        assert_eq!(argmax(&v).map(|p| p.0), Some(50));
+    }
+
+    #[test]
+    fn runs_cover_a_whole_row_and_none() {
+        let v = vec![1.0f32; 40];
+        let mut r = Vec::new();
+        runs_at_or_above(&v, 0.5, |s, l| r.push((s, l)));
+        assert_eq!(r, vec![(0, 40)]);
+        r.clear();
+        runs_at_or_above(&v, 2.0, |s, l| r.push((s, l)));
+        assert!(r.is_empty());
+    }
+
+    #[test]
+    fn scale_below_leaves_the_scored_cells_and_nan() {
+        let mut v = vec![0.0, 1e-9, 0.5, 1.0, f32::NAN];
+        let mut t = Tally::default();
+        scale_below(&mut v, 0.5, 0.25, &mut t);
+        assert_eq!(&v[..4], &[0.0, 0.25e-9, 0.5, 1.0]);
+        assert!(v[4].is_nan());
+        assert_eq!(t.peak(), 1.0);
+    }
+
+    /// The fused passes write what the plain passes do and tally what they wrote.
+    #[test]
+    fn the_fused_passes_write_and_tally_as_the_plain_ones() {
+        let v = belief(9, 1003);
+        let (f, keep, add) = (1.7f32, 1.0 - 1e-6, 3e-12);
+        let tallied = |t: &Tally, w: &[f32]| {
+            assert!((t.sum() - sum_plain(w)).abs() <= 1e-12 * sum_plain(w));
+            assert_eq!(t.peak().to_bits(), peak_plain(w).to_bits());
+        };
+        let mut one = v.clone();
+        let mut t = Tally::default();
+        scale_and_mix(&mut one[..500], f, keep, add, &mut t);
+        scale_and_mix(&mut one[500..], f, keep, add, &mut t);
+        let mut two: Vec<f32> = v.iter().map(|x| x * f).collect();
+        two.iter_mut().for_each(|x| *x = keep * *x + add);
+        assert_eq!(one, two);
+        tallied(&t, &two);
+        let mut t = Tally::default();
+        let mut scaled = v.clone();
+        scale(&mut scaled, f, &mut t);
+        tallied(&t, &scaled);
+        let mut t = Tally::default();
+        let mut below = v.clone();
+        scale_below(&mut below, 0.5, f, &mut t);
+        let plain: Vec<f32> = v.iter().map(|&x| if x < 0.5 { x * f } else { x }).collect();
+        assert_eq!(below, plain);
+        tallied(&t, &below);
+        let mut t = Tally::default();
+        let mut copied = vec![7.0; v.len()];
+        copy(&mut copied, &v, &mut t);
+        assert_eq!(copied, v);
+        tallied(&t, &v);
+        let top = peak_plain(&v);
+        assert_eq!(find(&v, top), v.iter().position(|&x| x == top));
+        assert_eq!(find(&v, 2.0), None);
+    }
+}
