@@ -259,6 +259,39 @@ fn converges_from_global_initialisation_and_tracks() {
     );
 }
 
+/// What the fused passes carry from one to the next is what a pass of its own would find: the
+/// peak the selective threshold starts from, after the motion and after the weighing, and the
+/// most probable cell the estimate starts from, over a global start and a drive.
+#[test]
+fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
+    let map = hospital();
+    let mut grid = MarkovGrid::new(
+        MarkovGridConfig {
+            motion: motion(),
+            ..MarkovGridConfig::default()
+        },
+        &map,
+    );
+    let mut last: Option<Pose2> = None;
+    let mut checked = 0;
+    drive(&map, &CORRIDOR, 0.0, 5, |_, odom, scan| {
+        if last.is_some_and(|l| !moved_enough(&l, odom, 0.25, 10f64.to_radians())) {
+            return;
+        }
+        if let Some(l) = last {
+            grid.apply_motion(&l, odom);
+            assert_eq!(grid.peak, Some(belief_ops::peak(&grid.belief)));
+        }
+        last = Some(*odom);
+        let pts = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60).returns();
+        let best = grid.weigh(&map, &pts, scan.range_max);
+        assert_eq!(best, belief_ops::argmax(&grid.belief).map(|b| b.0));
+        assert_eq!(grid.peak, Some(belief_ops::peak(&grid.belief)));
+        checked += 1;
+    });
+    assert!(checked > 50, "{checked} updates");
+}
+
 /// The most probable cell is the one `max_by` with `total_cmp`, ties to the first, picks: on
 /// ties, zeros of both signs, subnormals, infinities and NaNs.
 #[test]
