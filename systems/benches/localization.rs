@@ -221,11 +221,11 @@ fn belief_passes(c: &mut Criterion) {
     g.bench_function("peak_plain", |b| {
         b.iter(|| black_box(belief_ops::peak_plain(&v)))
     });
-    g.bench_function("copy", |b| {
+    g.bench_function("tally", |b| {
         b.iter(|| {
             let mut t = belief_ops::Tally::default();
-            belief_ops::copy(&mut out, &v, &mut t);
-            black_box(t.sum())
+            t.add(&v);
+            black_box((t.sum(), t.peak()))
         })
     });
     g.bench_function("scale", |b| {

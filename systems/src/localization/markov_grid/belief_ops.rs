@@ -108,31 +108,84 @@ const RUN_BLOCK: usize = 32;
 pub fn runs_at_or_above(row: &[f32], threshold: f32, mut emit: impl FnMut(usize, usize)) {
     let mut start: Option<usize> = None;
     for (b, block) in row.chunks(RUN_BLOCK).enumerate() {
-        let at = b * RUN_BLOCK;
         let above = block
             .iter()
             .fold(0usize, |n, &x| n + usize::from(x >= threshold));
-        if above == 0 {
-            if let Some(s) = start.take() {
-                emit(s, at - s);
-            }
-        } else if above == block.len() {
-            start.get_or_insert(at);
-        } else {
-            for (i, &x) in block.iter().enumerate() {
-                match (x >= threshold, start) {
-                    (true, None) => start = Some(at + i),
-                    (false, Some(s)) => {
-                        emit(s, at + i - s);
-                        start = None;
-                    }
-                    _ => {}
-                }
-            }
-        }
+        runs_in_block(
+            block,
+            b * RUN_BLOCK,
+            above,
+            threshold,
+            &mut start,
+            &mut emit,
+        );
     }
     if let Some(s) = start {
         emit(s, row.len() - s);
+    }
+}
+
+/// Multiplies every value of `row` by `factor`, then calls `emit(start, len)` for every maximal
+/// run of the results at or above `threshold`: exactly [`scale`] then [`runs_at_or_above`], in
+/// one pass.
+pub fn scale_and_find_runs(
+    row: &mut [f32],
+    factor: f32,
+    threshold: f32,
+    mut emit: impl FnMut(usize, usize),
+) {
+    let n = row.len();
+    let mut start: Option<usize> = None;
+    let (blocks, rest) = row.as_chunks_mut::<RUN_BLOCK>();
+    let mut scale = |block: &mut [f32], at: usize, start: &mut Option<usize>| {
+        let mut above = 0usize;
+        for x in block.iter_mut() {
+            let y = *x * factor;
+            *x = y;
+            above += usize::from(y >= threshold);
+        }
+        runs_in_block(block, at, above, threshold, start, &mut emit);
+    };
+    let mut at = 0;
+    for b in blocks {
+        scale(b, at, &mut start);
+        at += RUN_BLOCK;
+    }
+    scale(rest, at, &mut start);
+    if let Some(s) = start {
+        emit(s, n - s);
+    }
+}
+
+/// The runs of one block of a row, which starts at `at` and has `above` values at or above
+/// `threshold`, `start` being where the run still open began: whole blocks below or above in one
+/// step, the others value by value.
+#[inline(always)]
+fn runs_in_block(
+    block: &[f32],
+    at: usize,
+    above: usize,
+    threshold: f32,
+    start: &mut Option<usize>,
+    emit: &mut impl FnMut(usize, usize),
+) {
+    if above == 0 {
+        if let Some(s) = start.take() {
+            emit(s, at - s);
+        }
+    } else if above == block.len() {
+        start.get_or_insert(at);
+    } else {
+        for (i, &x) in block.iter().enumerate() {
+            match (x >= threshold, *start) {
+                (true, None) => *start = Some(at + i),
+                (false, Some(s)) => {
+                    emit(s, at + i - s);
+                    *start = None;
+                }
+                _ => {}
+            }
+        }
     }
 }
 
@@ -189,13 +242,6 @@ pub fn scale(v: &mut [f32], factor: f32, t: &mut Tally) {
 /// uniform mix in one pass, rounded as the two passes one after the other would be.
 pub fn scale_and_mix(v: &mut [f32], factor: f32, keep: f32, add: f32, t: &mut Tally) {
     map_tallied(v, t, |x| keep * (x * factor) + add);
-}
-
-/// Copies `src` into `dst` (as much as both hold), tallying it.
-pub fn copy(dst: &mut [f32], src: &[f32], t: &mut Tally) {
-    let n = dst.len().min(src.len());
-    dst[..n].copy_from_slice(&src[..n]);
-    t.add(&dst[..n]);
 }
 
 /// [`f32::total_cmp`]'s order as integers.
@@ -265,6 +311,17 @@ mod tests {
                 runs_at_or_above(&v, threshold, |s, l| fast.push((s, l)));
                 runs_at_or_above_plain(&v, threshold, |s, l| plain.push((s, l)));
                 assert_eq!(fast, plain, "n {n}, threshold {threshold}");
+                // scaled, then the runs, in one pass
+                let (mut fused, mut scaled) = (v.clone(), v.clone());
+                let (mut fast, mut plain) = (Vec::new(), Vec::new());
+                scale_and_find_runs(&mut fused, 1.3, threshold, |s, l| fast.push((s, l)));
+                scale(&mut scaled, 1.3, &mut Tally::default());
+                runs_at_or_above_plain(&scaled, threshold, |s, l| plain.push((s, l)));
+                assert_eq!(
+                    (fused, fast),
+                    (scaled, plain),
+                    "n {n}, threshold {threshold}"
+                );
             }
         }
     }
@@ -330,9 +387,8 @@ mod tests {
         assert_eq!(below, plain);
         tallied(&t, &below);
         let mut t = Tally::default();
-        let mut copied = vec![7.0; v.len()];
-        copy(&mut copied, &v, &mut t);
-        assert_eq!(copied, v);
+        t.add(&v[..10]);
+        t.add(&v[10..]);
         tallied(&t, &v);
         let top = peak_plain(&v);
         assert_eq!(find(&v, top), v.iter().position(|&x| x == top));

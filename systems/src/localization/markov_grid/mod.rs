@@ -98,9 +98,8 @@ pub struct MarkovGrid {
     pub sub_cell: SubCell,
     /// Motion noise not yet blurred in: position (cells²) and heading (bins²) variance.
     pending_noise: [f64; 2],
-    /// The belief's largest value, when the pass that last wrote it tallied it (the
-    /// normalisation after a motion): the selective update's threshold without a pass of its own.
-    peak: Option<f32>,
+    /// What the pass that last wrote the belief found that the next one needs.
+    carried: Option<Carried>,
     scratch: Vec<f32>,
     tmp: Vec<f32>,
     field: Option<PaddedField>,
@@ -112,6 +111,15 @@ pub struct MarkovGrid {
     pub estimate: Option<PoseEstimate>,
     /// The odometry pose of the scan `estimate` was refined on.
     estimate_odom: Option<Pose2>,
+}
+
+/// What a pass over the belief found that the next needs, valid until the belief changes
+/// otherwise: its largest value (the selective threshold's scale) and, after a motion, the runs
+/// at or above the threshold that gives, per layer, with their number of cells.
+#[derive(Clone, Debug)]
+struct Carried {
+    peak: f32,
+    runs: Option<(Vec<Vec<Span>>, usize)>,
 }
 
 /// The motion noise variance (cells², bins²) worth a blur pass over the grid: smaller ones
@@ -187,7 +195,7 @@ impl MarkovGrid {
             belief: vec![0.0; layout.len()],
             sub_cell: SubCell::centred(&layout),
             pending_noise: [0.0; 2],
-            peak: None,
+            carried: None,
             scratch: vec![0.0; layout.len()],
             tmp: Vec::new(),
             sample: sample_cells(&layout),
@@ -233,7 +241,7 @@ impl MarkovGrid {
     }
 
     fn fill_uniform(&mut self) {
-        self.peak = None;
+        self.carried = None;
         let l = &self.layout;
         let n = (l.free_count() * l.n_theta).max(1) as f32;
         self.belief.iter_mut().for_each(|v| *v = 0.0);
@@ -255,21 +263,73 @@ impl MarkovGrid {
     /// Scales the belief, which sums to `total`, to sum 1 and keeps its largest value; false
     /// if it holds no mass.
     fn normalise_sum(&mut self, total: f64) -> bool {
-        self.peak = None;
+        self.carried = None;
         let Some(s) = normaliser(total) else {
             return false;
         };
         let mut t = belief_ops::Tally::default();
         belief_ops::scale(&mut self.belief, s, &mut t);
-        self.peak = Some(t.peak());
+        self.carried = Some(Carried {
+            peak: t.peak(),
+            runs: None,
+        });
         true
+    }
+
+    /// [`MarkovGrid::normalise_sum`] for a belief tallied as `t`, finding on the way the runs
+    /// the next correction scores: the scaled peak is the peak scaled (rounding keeps the
+    /// order), so the threshold is known before the pass.
+    fn normalise_finding_runs(&mut self, t: &belief_ops::Tally) -> bool {
+        self.carried = None;
+        let Some(s) = normaliser(t.sum()) else {
+            return false;
+        };
+        let peak = t.peak() * s;
+        if self.config.selective_threshold <= 0.0 {
+            belief_ops::scale(&mut self.belief, s, &mut belief_ops::Tally::default());
+            self.carried = Some(Carried { peak, runs: None });
+            return true;
+        }
+        let threshold = self.threshold(peak);
+        let l = &self.layout;
+        // the cells outside free space hold 0, scaled or not
+        let runs: Vec<Vec<Span>> = self
+            .belief
+            .par_chunks_mut(l.layer())
+            .map(|b| {
+                let mut out = Vec::new();
+                for sp in &l.spans {
+                    let a = sp.j as usize * l.nx + sp.i0 as usize;
+                    let cells = &mut b[a..a + sp.len as usize];
+                    belief_ops::scale_and_find_runs(cells, s, threshold, |i, n| {
+                        out.push(Span {
+                            j: sp.j,
+                            i0: sp.i0 + i as u32,
+                            len: n as u32,
+                        })
+                    });
+                }
+                out
+            })
+            .collect();
+        let n = runs.iter().flatten().map(|r| r.len as usize).sum();
+        self.carried = Some(Carried {
+            peak,
+            runs: Some((runs, n)),
+        });
+        true
+    }
+
+    /// The selective update's threshold for a belief whose largest value is `peak`.
+    fn threshold(&self, peak: f32) -> f32 {
+        (self.config.selective_threshold as f32 * peak).max(f32::MIN_POSITIVE)
     }
 
     /// Prediction for the odometry motion `from` → `to`.
     pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
         let l = &self.layout;
-        let mut total =
+        let mut tally =
             prediction::shift(l, &d, &mut self.sub_cell, &self.belief, &mut self.scratch);
         std::mem::swap(&mut self.belief, &mut self.scratch);
         // a blur as wide as the grid already spreads the mass over all of it: capped there, so
@@ -283,16 +343,18 @@ impl MarkovGrid {
             let k = prediction::kernel_of_variance(self.pending_noise[0]);
             prediction::blur_xy(&self.layout, &k, &mut self.belief, &mut self.tmp);
             self.pending_noise[0] = 0.0;
-            total = belief_ops::sum(&self.belief);
+            tally = belief_ops::Tally::default();
+            tally.add(&self.belief);
         }
         if self.pending_noise[1] >= BLUR_VARIANCE {
             let k = prediction::kernel_of_variance(self.pending_noise[1]);
             prediction::blur_theta(&self.layout, &k, &self.belief, &mut self.scratch);
             std::mem::swap(&mut self.belief, &mut self.scratch);
             self.pending_noise[1] = 0.0;
-            total = belief_ops::sum(&self.belief);
+            tally = belief_ops::Tally::default();
+            tally.add(&self.belief);
         }
-        if !self.normalise_sum(total) {
+        if !self.normalise_finding_runs(&tally) {
             self.fill_uniform();
         }
     }
@@ -417,13 +479,17 @@ impl MarkovGrid {
         let lambda = self.config.likelihood_exponent as f32;
         // selective update only when it skips at least half of the cells
         let cells = self.layout.free_count() * self.layout.n_theta;
-        let peak = match self.peak.take() {
-            Some(p) => p,
+        let carried = self.carried.take();
+        let peak = match &carried {
+            Some(c) => c.peak,
             None => belief_ops::peak(&self.belief),
         };
-        let threshold = (self.config.selective_threshold as f32 * peak).max(f32::MIN_POSITIVE);
+        let threshold = self.threshold(peak);
         let selective = (self.config.selective_threshold > 0.0)
-            .then(|| self.active_runs(threshold))
+            .then(|| match carried.and_then(|c| c.runs) {
+                Some(runs) => runs,
+                None => self.active_runs(threshold),
+            })
             .filter(|(_, n)| 2 * n < cells);
         let sampled = self.score(map, points, range_max, selective.as_ref().map(|a| &a.0[..]));
         let l = &self.layout;
@@ -517,7 +583,7 @@ impl MarkovGrid {
         // the most probable cell is the first holding the largest value (for positive, finite
         // values, the first maximum in total_cmp's order)
         let peak = t.peak();
-        self.peak = Some(peak);
+        self.carried = Some(Carried { peak, runs: None });
         (peak > 0.0)
             .then(|| belief_ops::find(&self.belief, peak))
             .flatten()

@@ -14,8 +14,8 @@
 //! odometry's own variance, and along a corridor, where a scan says little about the position
 //! along it, the histogram drifted away from the robot by half a metre.
 
-use super::belief_ops::{Tally, copy};
-use super::layout::Layout;
+use super::belief_ops::Tally;
+use super::layout::{Layout, Span};
 use crate::localization::motion_model::OdometryDelta;
 
 /// Where the mass of the grid sits within its cells, carried from motion to motion: per θ
@@ -58,49 +58,78 @@ impl SubCell {
 /// Moves `src` (all θ layers, at the offsets `sub`) by `d` into `dst`, and `sub` to the offsets
 /// of the moved mass. Every free cell of `dst` is written: the mass from its source cell if that
 /// lies in the grid, 0 otherwise (mass that leaves the grid or lands on an occupied or unknown
-/// cell is dropped). Neither `src` nor `dst` holds anything outside free space. Returns the sum
-/// of `dst`.
+/// cell is dropped). Neither `src` nor `dst` holds anything outside free space. Returns `dst`'s
+/// tally (sum and peak).
 pub fn shift(
     layout: &Layout,
     d: &OdometryDelta,
     sub: &mut SubCell,
     src: &[f32],
     dst: &mut [f32],
-) -> f64 {
+) -> Tally {
     let (moves, turn) = layer_moves(layout, d, sub);
     let (nx, ny) = (layout.nx as isize, layout.ny as isize);
     let layer = layout.layer();
     let mut tally = Tally::default();
+    // the spans of each row, in the order the layout lists them (by row, then column)
+    let rows = row_spans(layout);
     for (k, m) in moves.iter().enumerate() {
         let from = &src[k * layer..(k + 1) * layer];
         let into = &mut dst[m.to * layer..(m.to + 1) * layer];
-        for s in &layout.spans {
-            let cells = &mut into[s.j as usize * layout.nx..][s.i0 as usize..][..s.len as usize];
-            let j = s.j as isize - m.iy;
-            // the span's columns whose source column lies in the grid
-            let (i0, i1) = (s.i0 as isize, (s.i0 + s.len) as isize);
-            let (a, b) = ((i0 - m.ix).max(0) + m.ix, (i1 - m.ix).min(nx) + m.ix);
-            if j < 0 || j >= ny || a >= b {
-                cells.fill(0.0);
+        // the target columns whose source column lies in the grid
+        let (a, b) = (
+            m.ix.clamp(0, nx) as usize,
+            (nx + m.ix).clamp(0, nx) as usize,
+        );
+        for (tj, spans) in rows.iter().enumerate() {
+            let (Some(first), Some(last)) = (spans.first(), spans.last()) else {
+                continue;
+            };
+            let row = &mut into[tj * layout.nx..][..layout.nx];
+            let j = tj as isize - m.iy;
+            // the free extent of the row that has a source: one copy, then the cells of it
+            // that are not free cleared, and the free cells outside it too
+            let lo = (first.i0 as usize).max(a);
+            let hi = ((last.i0 + last.len) as usize).min(b);
+            if j < 0 || j >= ny || lo >= hi {
+                for s in *spans {
+                    row[s.i0 as usize..][..s.len as usize].fill(0.0);
+                }
                 continue;
             }
-            let (a, b) = ((a - i0) as usize, (b - i0) as usize);
-            let source = &from[j as usize * layout.nx..];
-            let first = (i0 + a as isize - m.ix) as usize;
-            cells[..a].fill(0.0);
-            cells[b..].fill(0.0);
-            copy(
-                &mut cells[a..b],
-                &source[first..first + (b - a)],
-                &mut tally,
-            );
+            let shift = |i: usize| (i as isize - m.ix) as usize;
+            let source = &from[j as usize * layout.nx..][..layout.nx];
+            row[lo..hi].copy_from_slice(&source[shift(lo)..shift(hi)]);
+            let mut free_to = first.i0 as usize;
+            for s in *spans {
+                let (s0, s1) = (s.i0 as usize, (s.i0 + s.len) as usize);
+                // the gap before this span, within the copy
+                row[free_to.max(lo)..s0.min(hi).max(free_to.max(lo))].fill(0.0);
+                // this span's cells outside the copy
+                row[s0..s1.min(lo).max(s0)].fill(0.0);
+                row[s0.max(hi).min(s1)..s1].fill(0.0);
+                free_to = s1;
+            }
+            tally.add(&row[lo..hi]);
         }
     }
     for m in &moves {
         sub.xy[m.to] = m.rest;
     }
     sub.theta = turn;
-    tally.sum()
+    tally
+}
+
+/// The layout's spans row by row (they are listed by row, then column).
+fn row_spans(layout: &Layout) -> Vec<&[Span]> {
+    let mut rows = vec![&layout.spans[..0]; layout.ny];
+    let mut rest = &layout.spans[..];
+    while let Some(s) = rest.first() {
+        let n = rest.iter().take_while(|t| t.j == s.j).count();
+        rows[s.j as usize] = &rest[..n];
+        rest = &rest[n..];
+    }
+    rows
 }
 
 /// Where one θ layer's mass goes: layer `to`, by `ix`, `iy` whole cells, leaving `rest` (cells,
@@ -299,7 +328,7 @@ mod tests {
                 .collect();
             let mut plain = vec![0.0f32; l.len()];
             let (mut sub_fast, mut sub_plain) = (sub.clone(), sub.clone());
-            let total = shift(&l, &d, &mut sub_fast, &src, &mut fast);
+            let total = shift(&l, &d, &mut sub_fast, &src, &mut fast).sum();
             shift_plain(&l, &d, &mut sub_plain, &src, &mut plain);
             assert!(
                 fast.iter()

@@ -260,8 +260,9 @@ fn converges_from_global_initialisation_and_tracks() {
 }
 
 /// What the fused passes carry from one to the next is what a pass of its own would find: the
-/// peak the selective threshold starts from, after the motion and after the weighing, and the
-/// most probable cell the estimate starts from, over a global start and a drive.
+/// peak the selective threshold starts from, after the motion and after the weighing, the runs
+/// the correction scores, and the most probable cell the estimate starts from, over a global
+/// start and a drive.
 #[test]
 fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
     let map = hospital();
@@ -280,13 +281,19 @@ fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
         }
         if let Some(l) = last {
             grid.apply_motion(&l, odom);
-            assert_eq!(grid.peak, Some(belief_ops::peak(&grid.belief)));
+            let carried = grid.carried.clone().unwrap();
+            assert_eq!(carried.peak, belief_ops::peak(&grid.belief));
+            let threshold = grid.threshold(carried.peak);
+            assert_eq!(carried.runs, Some(grid.active_runs(threshold)));
         }
         last = Some(*odom);
         let pts = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60).returns();
         let best = grid.weigh(&map, &pts, scan.range_max);
         assert_eq!(best, belief_ops::argmax(&grid.belief).map(|b| b.0));
-        assert_eq!(grid.peak, Some(belief_ops::peak(&grid.belief)));
+        assert_eq!(
+            grid.carried.as_ref().map(|c| c.peak),
+            Some(belief_ops::peak(&grid.belief))
+        );
         checked += 1;
     });
     assert!(checked > 50, "{checked} updates");
