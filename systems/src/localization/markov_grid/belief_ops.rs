@@ -100,7 +100,7 @@ pub fn peak_plain(v: &[f32]) -> f32 {
 }
 
 /// Cells [`runs_at_or_above`] tests at once.
-const RUN_BLOCK: usize = 32;
+pub const RUN_BLOCK: usize = 32;
 
 /// Calls `emit(start, len)` for every maximal run of `row` at or above `threshold`, in order:
 /// exactly [`runs_at_or_above_plain`]. Blocks of [`RUN_BLOCK`] wholly below or wholly above the
