@@ -180,6 +180,32 @@ fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32
     }
 }
 
+/// The runs of one θ layer: `find(cells, emit)` is called for each span of free cells (its
+/// place in the layer) and reports runs within it as `emit(start, len)`.
+fn layer_runs(
+    l: &Layout,
+    mut find: impl FnMut(std::ops::Range<usize>, &mut dyn FnMut(usize, usize)),
+) -> Vec<Span> {
+    let mut out = Vec::new();
+    for sp in &l.spans {
+        let a = sp.j as usize * l.nx + sp.i0 as usize;
+        find(a..a + sp.len as usize, &mut |i, n| {
+            out.push(Span {
+                j: sp.j,
+                i0: sp.i0 + i as u32,
+                len: n as u32,
+            })
+        });
+    }
+    out
+}
+
+/// Runs per layer with their number of cells.
+fn counted(runs: Vec<Vec<Span>>) -> (Vec<Vec<Span>>, usize) {
+    let n = runs.iter().flatten().map(|r| r.len as usize).sum();
+    (runs, n)
+}
+
 /// The factor that scales a belief summing to `total` to sum 1, if it holds mass.
 fn normaliser(total: f64) -> Option<f32> {
     (total > 0.0 && total.is_finite()).then(|| (1.0 / total) as f32)
@@ -297,25 +323,14 @@ impl MarkovGrid {
             .belief
             .par_chunks_mut(l.layer())
             .map(|b| {
-                let mut out = Vec::new();
-                for sp in &l.spans {
-                    let a = sp.j as usize * l.nx + sp.i0 as usize;
-                    let cells = &mut b[a..a + sp.len as usize];
-                    belief_ops::scale_and_find_runs(cells, s, threshold, |i, n| {
-                        out.push(Span {
-                            j: sp.j,
-                            i0: sp.i0 + i as u32,
-                            len: n as u32,
-                        })
-                    });
-                }
-                out
+                layer_runs(l, |cells, emit| {
+                    belief_ops::scale_and_find_runs(&mut b[cells], s, threshold, emit)
+                })
             })
             .collect();
-        let n = runs.iter().flatten().map(|r| r.len as usize).sum();
         self.carried = Some(Carried {
             peak,
-            runs: Some((runs, n)),
+            runs: Some(counted(runs)),
         });
         true
     }
@@ -438,22 +453,12 @@ impl MarkovGrid {
             .belief
             .par_chunks(l.layer())
             .map(|b| {
-                let mut out = Vec::new();
-                for s in &l.spans {
-                    let a = s.j as usize * l.nx + s.i0 as usize;
-                    belief_ops::runs_at_or_above(&b[a..a + s.len as usize], threshold, |i, n| {
-                        out.push(Span {
-                            j: s.j,
-                            i0: s.i0 + i as u32,
-                            len: n as u32,
-                        })
-                    });
-                }
-                out
+                layer_runs(l, |cells, emit| {
+                    belief_ops::runs_at_or_above(&b[cells], threshold, emit)
+                })
             })
             .collect();
-        let n = runs.iter().flatten().map(|r| r.len as usize).sum();
-        (runs, n)
+        counted(runs)
     }
 
     /// Correction of the belief by a scan's endpoints (base frame, max-range readings left out).
