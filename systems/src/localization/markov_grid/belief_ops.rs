@@ -1,8 +1,8 @@
 //! Passes over the whole belief (about a million cells at the default 0.25 m × 10° on a
 //! 64 × 32 m floor), run at every update, written so that they vectorise: each keeps
 //! [`LANES`] independent partial results instead of one chain of dependent operations, which a
-//! compiler may not reorder for floating point. Each has its plain version beside it, which the
-//! tests hold it to.
+//! compiler may not reorder for floating point. The tests hold each to the plain computation
+//! (`sum_plain`, `peak_plain`, `runs_at_or_above_plain`, the scalings written out).
 
 /// Independent partial results per pass.
 pub const LANES: usize = 8;

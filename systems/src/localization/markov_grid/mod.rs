@@ -22,7 +22,9 @@
 //!   belief itself stays a histogram.
 //!
 //! Like MCL, it updates only after a minimum travel or turn of the odometry. Layers (θ) are
-//! scored in parallel; each layer's result depends on that layer only.
+//! scored in parallel; each layer's result depends on that layer only. The passes over the whole
+//! belief ([`belief_ops`]) each tally what the next one needs (sum, peak, the runs above the
+//! selective threshold), so an update passes over it five times.
 
 pub mod belief_ops;
 pub mod correction;
