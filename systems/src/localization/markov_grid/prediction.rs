@@ -134,18 +134,18 @@ fn row_spans(layout: &Layout) -> Vec<&[Span]> {
 
 /// Where one θ layer's mass goes: layer `to`, by `ix`, `iy` whole cells, leaving `rest` (cells,
 /// each within ±½) as the moved mass's offset.
-pub struct LayerMove {
-    pub to: usize,
-    pub ix: isize,
-    pub iy: isize,
-    pub rest: [f64; 2],
+struct LayerMove {
+    to: usize,
+    ix: isize,
+    iy: isize,
+    rest: [f64; 2],
 }
 
 /// Every layer's move under the motion `d`, and the heading offset (bins) left over for all
 /// layers: each layer moves by its offset plus the motion as seen from its heading, rounded to
 /// whole cells, and all turn by the same whole bins. A move past the grid's extent drops all
 /// the mass, as any longer one: clamped there so the cell arithmetic stays within integers.
-pub fn layer_moves(layout: &Layout, d: &OdometryDelta, sub: &SubCell) -> (Vec<LayerMove>, f64) {
+fn layer_moves(layout: &Layout, d: &OdometryDelta, sub: &SubCell) -> (Vec<LayerMove>, f64) {
     let nt = layout.n_theta as isize;
     let turn = sub.theta + (d.rot1 + d.rot2) / layout.theta_step();
     let dk = turn.round();

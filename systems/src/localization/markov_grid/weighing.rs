@@ -1,0 +1,293 @@
+//! The correction of the belief by a scan (Probabilistic Robotics §8.2, Table 8.1 line 5) with
+//! the selective update of Fox, Burgard & Thrun (JAIR 11 (1999), §4.2): the cells at or above
+//! a fraction of the most probable one's are scored on the likelihood field ([`super::correction`]),
+//! the others weighted alike by the scan's likelihood averaged over a fixed sample of the floor.
+
+use super::layout::{Layout, Span};
+use super::{Carried, MarkovGrid, belief_ops, correction, normaliser};
+use crate::localization::map::LocalizationMap;
+use correction::PaddedField;
+use rayon::prelude::*;
+use std::borrow::Cow;
+
+/// Cells between two sample cells of the selective update (about 2 000 of the hospital's
+/// 0.97 million free cells × bins).
+const SAMPLE_STRIDE: usize = 487;
+
+/// The selective update's sample: every `SAMPLE_STRIDE`-th cell in (layer, span) order.
+pub(super) fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
+    let mut c = 0usize;
+    (0..l.n_theta)
+        .map(|_| {
+            let mut v = Vec::new();
+            for s in &l.spans {
+                for i in s.i0..s.i0 + s.len {
+                    if c.is_multiple_of(SAMPLE_STRIDE) {
+                        v.push((i, s.j));
+                    }
+                    c += 1;
+                }
+            }
+            v
+        })
+        .collect()
+}
+
+/// The endpoints of `points` a cell can see: finite and within the map's diagonal. Borrowed
+/// when that is all of them (a scan of the map always is).
+pub(super) fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32; 2]]> {
+    let g = &map.grid;
+    let diagonal = (g.width as f64 * g.resolution).hypot(g.height as f64 * g.resolution);
+    let ok = |p: &[f32; 2]| (p[0] as f64).hypot(p[1] as f64) <= diagonal;
+    if points.iter().all(ok) {
+        Cow::Borrowed(points)
+    } else {
+        Cow::Owned(points.iter().copied().filter(ok).collect())
+    }
+}
+
+/// The runs of one θ layer: `find(cells, emit)` is called for each span of free cells (its
+/// place in the layer) and reports runs within it as `emit(start, len)`.
+pub(super) fn layer_runs(
+    l: &Layout,
+    mut find: impl FnMut(std::ops::Range<usize>, &mut dyn FnMut(usize, usize)),
+) -> Vec<Span> {
+    let mut out = Vec::new();
+    for sp in &l.spans {
+        let a = sp.j as usize * l.nx + sp.i0 as usize;
+        find(a..a + sp.len as usize, &mut |i, n| {
+            out.push(Span {
+                j: sp.j,
+                i0: sp.i0 + i as u32,
+                len: n as u32,
+            })
+        });
+    }
+    out
+}
+
+/// Runs per layer with their number of cells.
+pub(super) fn counted(runs: Vec<Vec<Span>>) -> (Vec<Vec<Span>>, usize) {
+    let n = runs.iter().flatten().map(|r| r.len as usize).sum();
+    (runs, n)
+}
+
+impl MarkovGrid {
+    /// Log-likelihood of the scan endpoints `points` (base frame) into the scratch buffer, for
+    /// every free cell or, given `active` (per layer), for those runs only; then also for the
+    /// sample cells, whose values are returned.
+    pub(super) fn score(
+        &mut self,
+        map: &LocalizationMap,
+        points: &[[f32; 2]],
+        range_max: f32,
+        active: Option<&[Vec<Span>]>,
+    ) -> Vec<f32> {
+        let reach = points
+            .iter()
+            .map(|p| (p[0] as f64).hypot(p[1] as f64))
+            .fold(0.0, f64::max);
+        if self.field.as_ref().is_none_or(|f| f.reach < reach) {
+            self.field = Some(PaddedField::new(&map.field, reach.max(1.0)));
+        }
+        let laser = self.config.laser;
+        let tables: Vec<[f32; 256]> = points
+            .iter()
+            .map(|p| {
+                let range = (p[0] as f64).hypot(p[1] as f64);
+                correction::beam_table(
+                    &map.field,
+                    &laser,
+                    range_max as f64,
+                    self.layout.resolution,
+                    self.layout.theta_step(),
+                    range,
+                )
+            })
+            .collect();
+        let field = self.field.as_ref().expect("built above");
+        let layout = &self.layout;
+        let (sample, sub) = (&self.sample, &self.sub_cell);
+        let sampled: Vec<Vec<f32>> = self
+            .scratch
+            .par_chunks_mut(layout.layer())
+            .enumerate()
+            .map(|(k, out)| {
+                // the endpoints seen from this layer's cell poses: centre plus offset
+                let (s, c) = sub.heading(layout, k).sin_cos();
+                let (ox, oy) = sub.offset(layout, k);
+                let offsets: Vec<isize> = points
+                    .iter()
+                    .map(|p| {
+                        let (x, y) = (p[0] as f64, p[1] as f64);
+                        field.offset(ox + c * x - s * y, oy + s * x + c * y)
+                    })
+                    .collect();
+                let spans = active.map_or(&layout.spans[..], |a| &a[k][..]);
+                for r in spans {
+                    let a = r.j as usize * layout.nx + r.i0 as usize;
+                    out[a..a + r.len as usize].iter_mut().for_each(|v| *v = 0.0);
+                }
+                correction::layer_log_likelihood(field, &tables, layout, spans, &offsets, out);
+                if active.is_none() {
+                    return Vec::new();
+                }
+                sample[k]
+                    .iter()
+                    .map(|&(i, j)| {
+                        correction::cell_log_likelihood(
+                            field, &tables, layout, &offsets, i as usize, j as usize,
+                        )
+                    })
+                    .collect()
+            })
+            .collect();
+        sampled.concat()
+    }
+
+    /// The runs of cells at or above `threshold`, per layer, and their number.
+    pub(super) fn active_runs(&self, threshold: f32) -> (Vec<Vec<Span>>, usize) {
+        let l = &self.layout;
+        let runs: Vec<Vec<Span>> = self
+            .belief
+            .par_chunks(l.layer())
+            .map(|b| {
+                layer_runs(l, |cells, emit| {
+                    belief_ops::runs_at_or_above(&b[cells], threshold, emit)
+                })
+            })
+            .collect();
+        counted(runs)
+    }
+
+    /// Correction of the belief by a scan's endpoints (base frame, max-range readings left out).
+    /// Endpoints that are not finite, or farther than the map's diagonal (outside the map seen
+    /// from every cell, so they weigh every cell alike), are left out.
+    pub fn apply_scan(&mut self, map: &LocalizationMap, points: &[[f32; 2]], range_max: f32) {
+        self.weigh(map, &reachable(map, points), range_max);
+    }
+
+    /// [`MarkovGrid::apply_scan`] for endpoints already [`reachable`], returning where the
+    /// corrected belief is largest (the first such cell) if its last pass found it.
+    pub(super) fn weigh(
+        &mut self,
+        map: &LocalizationMap,
+        points: &[[f32; 2]],
+        range_max: f32,
+    ) -> Option<usize> {
+        if points.is_empty() {
+            return None;
+        }
+        let lambda = self.config.likelihood_exponent as f32;
+        // selective update only when it skips at least half of the cells
+        let cells = self.layout.free_count() * self.layout.n_theta;
+        let carried = self.carried.take();
+        let peak = match &carried {
+            Some(c) => c.peak,
+            None => belief_ops::peak(&self.belief),
+        };
+        let threshold = self.threshold(peak);
+        let selective = (self.config.selective_threshold > 0.0)
+            .then(|| match carried.and_then(|c| c.runs) {
+                Some(runs) => runs,
+                None => self.active_runs(threshold),
+            })
+            .filter(|(_, n)| 2 * n < cells);
+        let sampled = self.score(map, points, range_max, selective.as_ref().map(|a| &a.0[..]));
+        let l = &self.layout;
+        // the belief's sum after the weighing, tallied by it where it passes over every cell
+        let total = match selective {
+            None => {
+                let best = self
+                    .belief
+                    .iter()
+                    .zip(&self.scratch)
+                    .filter(|(p, _)| **p > 0.0)
+                    .map(|(_, l)| *l)
+                    .fold(f32::NEG_INFINITY, f32::max);
+                if best.is_finite() {
+                    for (p, &l) in self.belief.iter_mut().zip(&self.scratch) {
+                        if *p > 0.0 {
+                            *p *= (lambda * (l - best)).exp();
+                        }
+                    }
+                }
+                belief_ops::sum(&self.belief)
+            }
+            Some((runs, _)) => {
+                let layer = l.layer();
+                let best = runs
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(k, rs)| rs.iter().map(move |r| (k, r)))
+                    .flat_map(|(k, r)| {
+                        let a = k * layer + r.j as usize * l.nx + r.i0 as usize;
+                        self.scratch[a..a + r.len as usize].iter().copied()
+                    })
+                    .chain(sampled.iter().copied())
+                    .fold(f32::NEG_INFINITY, f32::max);
+                if best.is_finite() {
+                    let floor = sampled
+                        .iter()
+                        .map(|&v| (lambda * (v - best)).exp() as f64)
+                        .sum::<f64>()
+                        / sampled.len().max(1) as f64;
+                    // the cells not scored first, then the scored runs: those are the cells at
+                    // or above the threshold, which the first pass leaves as they are
+                    let mut all = belief_ops::Tally::default();
+                    belief_ops::scale_below(&mut self.belief, threshold, floor as f32, &mut all);
+                    // the sum: the tally's, with the scored cells' weighed values for their own
+                    let (mut unweighed, mut weighed) = (0.0f64, 0.0f64);
+                    for (k, rs) in runs.iter().enumerate() {
+                        for r in rs {
+                            let a = k * layer + r.j as usize * l.nx + r.i0 as usize;
+                            let cells = a..a + r.len as usize;
+                            for (p, &v) in self.belief[cells.clone()]
+                                .iter_mut()
+                                .zip(&self.scratch[cells])
+                            {
+                                unweighed += *p as f64;
+                                *p *= (lambda * (v - best)).exp();
+                                weighed += *p as f64;
+                            }
+                        }
+                    }
+                    all.sum() - unweighed + weighed
+                } else {
+                    belief_ops::sum(&self.belief)
+                }
+            }
+        };
+        // normalised and mixed with the uniform share in one pass over the free cells, which
+        // also finds the most probable cell
+        let s = match normaliser(total) {
+            Some(s) => s,
+            None => {
+                self.fill_uniform();
+                1.0
+            }
+        };
+        let mix = self.config.uniform_mix as f32;
+        let l = &self.layout;
+        let u = mix / (l.free_count() * l.n_theta).max(1) as f32;
+        let mut t = belief_ops::Tally::default();
+        if mix > 0.0 {
+            for k in 0..l.n_theta {
+                for sp in &l.spans {
+                    let a = k * l.layer() + sp.j as usize * l.nx + sp.i0 as usize;
+                    let cells = &mut self.belief[a..a + sp.len as usize];
+                    belief_ops::scale_and_mix(cells, s, 1.0 - mix, u, &mut t);
+                }
+            }
+        } else {
+            belief_ops::scale(&mut self.belief, s, &mut t);
+        }
+        // the most probable cell is the first holding the largest value (for positive, finite
+        // values, the first maximum in total_cmp's order)
+        let peak = t.peak();
+        self.carried = Some(Carried { peak, runs: None });
+        (peak > 0.0)
+            .then(|| belief_ops::find(&self.belief, peak))
+            .flatten()
+    }
+}
