@@ -15,9 +15,11 @@
 //! endpoint over a cell (an approximation of integrating the likelihood over the cell).
 
 use super::layout::{Layout, Span};
+use crate::localization::map::LocalizationMap;
 use crate::localization::mcl::LaserModelParams;
 use crate::world::DistanceField;
 use crate::world::distance_field::FAR;
+use std::borrow::Cow;
 
 /// A copy of the distance field with a border of `pad` cells reading "far".
 #[derive(Clone, Debug)]
@@ -124,4 +126,17 @@ pub fn beam_table(
         let d = d.min(laser.max_dist);
         ((laser.z_hit * (-d * d / (2.0 * var)).exp() + rand).max(1e-30)).ln() as f32
     })
+}
+
+/// The endpoints of `points` a cell can see: finite and within the map's diagonal. Borrowed
+/// when that is all of them (a scan of the map always is).
+pub fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32; 2]]> {
+    let g = &map.grid;
+    let diagonal = (g.width as f64 * g.resolution).hypot(g.height as f64 * g.resolution);
+    let ok = |p: &[f32; 2]| (p[0] as f64).hypot(p[1] as f64) <= diagonal;
+    if points.iter().all(ok) {
+        Cow::Borrowed(points)
+    } else {
+        Cow::Owned(points.iter().copied().filter(ok).collect())
+    }
 }

@@ -123,3 +123,31 @@ impl Layout {
         Some((i as usize, j as usize, k))
     }
 }
+
+impl Layout {
+    /// The runs of one θ layer: `find(cells, emit)` is called for each span of free cells (its
+    /// place in the layer) and reports runs within it as `emit(start, len)`.
+    pub fn runs(
+        &self,
+        mut find: impl FnMut(std::ops::Range<usize>, &mut dyn FnMut(usize, usize)),
+    ) -> Vec<Span> {
+        let mut out = Vec::new();
+        for sp in &self.spans {
+            let a = sp.j as usize * self.nx + sp.i0 as usize;
+            find(a..a + sp.len as usize, &mut |i, n| {
+                out.push(Span {
+                    j: sp.j,
+                    i0: sp.i0 + i as u32,
+                    len: n as u32,
+                })
+            });
+        }
+        out
+    }
+}
+
+/// Runs per layer with their number of cells.
+pub fn counted(runs: Vec<Vec<Span>>) -> (Vec<Vec<Span>>, usize) {
+    let n = runs.iter().flatten().map(|r| r.len as usize).sum();
+    (runs, n)
+}

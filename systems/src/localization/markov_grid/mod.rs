@@ -107,7 +107,7 @@ pub struct MarkovGrid {
     tmp: Vec<f32>,
     field: Option<PaddedField>,
     /// Per θ layer, the (i, j) cells whose mean likelihood stands for the floor's in the
-    /// selective update: every [`SAMPLE_STRIDE`]-th free cell.
+    /// selective update (built at the first correction).
     sample: Vec<Vec<(u32, u32)>>,
     last_odom: Option<Pose2>,
     pub updates: u64,
@@ -145,7 +145,7 @@ impl MarkovGrid {
             carried: None,
             scratch: vec![0.0; layout.len()],
             tmp: Vec::new(),
-            sample: weighing::sample_cells(&layout),
+            sample: Vec::new(),
             layout,
             config,
             field: None,
@@ -244,14 +244,14 @@ impl MarkovGrid {
             .belief
             .par_chunks_mut(l.layer())
             .map(|b| {
-                weighing::layer_runs(l, |cells, emit| {
+                l.runs(|cells, emit| {
                     belief_ops::scale_and_find_runs(&mut b[cells], s, threshold, emit)
                 })
             })
             .collect();
         self.carried = Some(Carried {
             peak,
-            runs: Some(weighing::counted(runs)),
+            runs: Some(layout::counted(runs)),
         });
         true
     }
@@ -314,7 +314,7 @@ impl MarkovGrid {
         points: &[[f32; 2]],
         range_max: f32,
     ) -> bool {
-        let points = weighing::reachable(map, points);
+        let points = correction::reachable(map, points);
         let best = self.weigh(map, &points, range_max);
         self.updates += 1;
         self.estimate = self.tracked_estimate(map, &points, range_max, best);

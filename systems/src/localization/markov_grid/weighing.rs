@@ -3,19 +3,19 @@
 //! a fraction of the most probable one's are scored on the likelihood field ([`super::correction`]),
 //! the others weighted alike by the scan's likelihood averaged over a fixed sample of the floor.
 
-use super::layout::{Layout, Span};
+use super::correction::reachable;
+use super::layout::{Layout, Span, counted};
 use super::{Carried, MarkovGrid, belief_ops, correction, normaliser};
 use crate::localization::map::LocalizationMap;
 use correction::PaddedField;
 use rayon::prelude::*;
-use std::borrow::Cow;
 
 /// Cells between two sample cells of the selective update (about 2 000 of the hospital's
 /// 0.97 million free cells × bins).
 const SAMPLE_STRIDE: usize = 487;
 
 /// The selective update's sample: every `SAMPLE_STRIDE`-th cell in (layer, span) order.
-pub(super) fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
+fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
     let mut c = 0usize;
     (0..l.n_theta)
         .map(|_| {
@@ -31,45 +31,6 @@ pub(super) fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
             v
         })
         .collect()
-}
-
-/// The endpoints of `points` a cell can see: finite and within the map's diagonal. Borrowed
-/// when that is all of them (a scan of the map always is).
-pub(super) fn reachable<'a>(map: &LocalizationMap, points: &'a [[f32; 2]]) -> Cow<'a, [[f32; 2]]> {
-    let g = &map.grid;
-    let diagonal = (g.width as f64 * g.resolution).hypot(g.height as f64 * g.resolution);
-    let ok = |p: &[f32; 2]| (p[0] as f64).hypot(p[1] as f64) <= diagonal;
-    if points.iter().all(ok) {
-        Cow::Borrowed(points)
-    } else {
-        Cow::Owned(points.iter().copied().filter(ok).collect())
-    }
-}
-
-/// The runs of one θ layer: `find(cells, emit)` is called for each span of free cells (its
-/// place in the layer) and reports runs within it as `emit(start, len)`.
-pub(super) fn layer_runs(
-    l: &Layout,
-    mut find: impl FnMut(std::ops::Range<usize>, &mut dyn FnMut(usize, usize)),
-) -> Vec<Span> {
-    let mut out = Vec::new();
-    for sp in &l.spans {
-        let a = sp.j as usize * l.nx + sp.i0 as usize;
-        find(a..a + sp.len as usize, &mut |i, n| {
-            out.push(Span {
-                j: sp.j,
-                i0: sp.i0 + i as u32,
-                len: n as u32,
-            })
-        });
-    }
-    out
-}
-
-/// Runs per layer with their number of cells.
-pub(super) fn counted(runs: Vec<Vec<Span>>) -> (Vec<Vec<Span>>, usize) {
-    let n = runs.iter().flatten().map(|r| r.len as usize).sum();
-    (runs, n)
 }
 
 impl MarkovGrid {
@@ -105,6 +66,9 @@ impl MarkovGrid {
                 )
             })
             .collect();
+        if self.sample.is_empty() {
+            self.sample = sample_cells(&self.layout);
+        }
         let field = self.field.as_ref().expect("built above");
         let layout = &self.layout;
         let (sample, sub) = (&self.sample, &self.sub_cell);
@@ -151,11 +115,7 @@ impl MarkovGrid {
         let runs: Vec<Vec<Span>> = self
             .belief
             .par_chunks(l.layer())
-            .map(|b| {
-                layer_runs(l, |cells, emit| {
-                    belief_ops::runs_at_or_above(&b[cells], threshold, emit)
-                })
-            })
+            .map(|b| l.runs(|cells, emit| belief_ops::runs_at_or_above(&b[cells], threshold, emit)))
             .collect();
         counted(runs)
     }
