@@ -27,13 +27,15 @@
 //! noise-free odometry while the others draw from the motion model; while the filter searches,
 //! the worst members are replaced by poses drawn from the scan (Mixture MCL's dual proposal
 //! [Thrun 2001, §4], `injection_candidates`), so the true place is in the population from the
-//! first scans on; once converged, the member the estimate follows is chosen, and refined, by
-//! its cost plus a Gaussian prior around where the odometry carried the last estimate (a
-//! maximum a posteriori choice, [`super::de_population::Gate`]), so it does not slide along a
-//! corridor to a pose that fits one scan marginally better; and a place outside the gate that
-//! fits clearly better for several updates in a row takes the estimate over (the sequential
-//! test of [`super::de_tracker`]), so a filter that settled on a look-alike wing moves to the
-//! right one without searching the whole floor again.
+//! first scans on; while searching, the estimate follows the look-alike place that has fitted
+//! best over the scans so far, and the filter converges only once that place stands out
+//! ([`super::de_places`]); once converged, the member the estimate follows is chosen, and
+//! refined, by its cost plus a Gaussian prior around where the odometry carried the last
+//! estimate (a maximum a posteriori choice, [`super::de_population::Gate`]), so it does not slide
+//! along a corridor to a pose that fits one scan marginally better; and a place outside the
+//! gate that fits clearly better for several updates in a row takes the estimate over (the
+//! sequential test of [`super::de_tracker`]), so a filter that settled on a look-alike wing
+//! moves to the right one without searching the whole floor again.
 
 use super::de_population::{Population, RangeMetric, range_costs, three_others};
 use super::de_tracker::{CycleSettings, DeTracker};

@@ -359,7 +359,8 @@ pub fn convergence(
     }
 }
 
-fn close(p: &[f64; 3], b: &[f64; 3], radius: f64, angle: f64) -> bool {
+/// Whether `p` is within `radius` (m) and `angle` (rad) of `b`.
+pub fn close(p: &[f64; 3], b: &[f64; 3], radius: f64, angle: f64) -> bool {
     (p[0] - b[0]).hypot(p[1] - b[1]) <= radius && wrap_angle(p[2] - b[2]).abs() <= angle
 }
 

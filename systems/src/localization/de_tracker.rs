@@ -2,10 +2,12 @@
 //! [Hospital thesis §3.9]): move the population by odometry, (while searching) replace the
 //! worst members by poses drawn from the scan, score it on the new scan, refine the best member
 //! locally, let the method evolve the population, keep the elite, (while converged) let a
-//! clearly better place outside the gate challenge the estimate, update the convergence state
+//! clearly better place outside the gate challenge the estimate, (while searching) weigh the
+//! look-alike places over the scans so far ([`super::de_places`]), update the convergence state
 //! and the estimate; once a converged filter is lost, a fresh population spread over the whole
 //! floor searches again.
 
+use super::de_places::Places;
 use super::de_population::{ESTIMATE_FLOOR, Gate, Population, RangeMetric, convergence};
 use super::map::LocalizationMap;
 use super::mcl::injection::scan_proposal;
@@ -57,6 +59,8 @@ pub struct DeTracker {
     challenger: Option<(Pose2, u32)>,
     /// The likelihood field's lookup table for the scan proposal (scans of one range_max).
     table: Option<Box<[f32; 256]>>,
+    /// While searching: the look-alike places weighed over several scans.
+    places: Places,
 }
 
 /// A challenger must cost at most this share of the leader's cost…
@@ -87,6 +91,7 @@ impl DeTracker {
             cost_per_nat: 0.0,
             challenger: None,
             table: None,
+            places: Places::default(),
         }
     }
 
@@ -191,6 +196,7 @@ impl DeTracker {
             if let Some((c, _)) = &mut self.challenger {
                 *c = c.compose(&step);
             }
+            self.places.carry(&step);
         }
         self.last_odom = Some(*odom);
         true
@@ -235,16 +241,31 @@ impl DeTracker {
         if let Some(g) = &gate {
             lead = self.challenge(g, lead);
         }
+        // while searching, the estimate follows the place that fits best over the scans so far,
+        // and the filter converges only once that place stands out
+        let mut settled = true;
+        if !self.converged {
+            self.evaluations += self.places.len() as u64;
+            (lead, settled) = self
+                .places
+                .update(&mut self.population, map, beams, s.metric);
+        }
         let was_converged = self.converged;
         (self.converged, self.streak) = convergence(
             self.converged,
             self.streak,
-            self.population.costs[lead],
+            if settled {
+                self.population.costs[lead]
+            } else {
+                f64::INFINITY
+            },
             s.converge_cost,
             s.converge_updates,
         );
         self.updates += 1;
-        if !self.converged {
+        if self.converged {
+            self.places.clear();
+        } else {
             self.challenger = None;
         }
         self.estimate = self.population.estimate(lead, 0.5, 0.2, ESTIMATE_FLOOR);

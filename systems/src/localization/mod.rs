@@ -6,6 +6,7 @@
 pub mod de_filter;
 pub mod de_mc;
 pub mod de_odometry;
+pub mod de_places;
 pub mod de_population;
 pub mod de_tracker;
 pub mod fixtures;

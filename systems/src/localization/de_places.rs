@@ -1,0 +1,259 @@
+//! The look-alike places a searching DE localizer weighs over several scans before it commits to
+//! one (multiple-hypothesis tracking, [Jensfelt 2001]). The hospital's wards repeat every 27 m:
+//! from the ward corridor, one scan fits the robot's ward and its twin almost alike, and a filter
+//! that followed the best member of each scan could settle on the twin and hold it for tens of
+//! seconds. Here every distinct place the population finds plausible is carried by the odometry
+//! and sums its cost (mean range error) over the scans since it was found; the estimate follows
+//! the place of lowest sum, and the filter may declare itself converged only once that place
+//! leads every other by [`SETTLED`]: several scans' evidence, or one scan that tells the places
+//! apart.
+//!
+//! The sums are of costs, not of log-likelihoods under a per-beam noise model: what tells
+//! look-alike places apart is a few beams that see a different doorway or corridor end, and a
+//! noise model fitted to the scan (a Laplace scale from the best fit, tempered as the Markov
+//! grid's likelihood) rated such differences so highly that the filter settled on a twin again.
+
+use super::de_population::{Population, RangeMetric, close, range_costs};
+use super::map::LocalizationMap;
+use super::mcl::BeamSubset;
+use crate::core::Pose2;
+
+/// The summed cost (m of mean range error for L1, m² for L2) by which the best place must lead
+/// every other.
+pub const SETTLED: f64 = 0.15;
+/// A place whose sum trails the best's by more than this is dropped.
+const DROP: f64 = 0.6;
+/// A member starts a place if its cost is at most this multiple of the best place's.
+const PLAUSIBLE: f64 = 1.25;
+/// Places kept at most.
+const MAX_PLACES: usize = 8;
+/// Members within this distance (m) and turn (rad) of a place belong to it.
+const RADIUS: f64 = 1.0;
+const ANGLE: f64 = 0.3;
+
+/// One place: its pose and its cost summed over the scans since it was found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Place {
+    pose: [f64; 3],
+    sum: f64,
+}
+
+/// The places of a searching filter, best first after [`Places::update`].
+#[derive(Clone, Debug, Default)]
+pub struct Places {
+    places: Vec<Place>,
+}
+
+impl Places {
+    /// Places held.
+    pub fn len(&self) -> usize {
+        self.places.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.places.is_empty()
+    }
+
+    /// Forgets every place (the filter converged, or searches the whole floor again).
+    pub fn clear(&mut self) {
+        self.places.clear();
+    }
+
+    /// Moves every place by the odometry `step` (robot frame).
+    pub fn carry(&mut self, step: &Pose2) {
+        for p in &mut self.places {
+            let q = Pose2::new(p.pose[0], p.pose[1], p.pose[2]).compose(step);
+            p.pose = [q.x, q.y, q.theta];
+        }
+    }
+
+    /// Weighs the places on the scan the population was just scored on: each place moves to its
+    /// best member if that fits better than its own pose, adds its cost to its sum, and every
+    /// plausible member away from the known places starts a new one (behind the best place by
+    /// [`SETTLED`] once there is one: a newcomer must earn the lead). Returns the member the
+    /// estimate follows (the best place's; its pose replaces the worst member if no member is
+    /// near it) and whether that place has settled.
+    pub fn update(
+        &mut self,
+        pop: &mut Population,
+        map: &LocalizationMap,
+        beams: &BeamSubset,
+        metric: RangeMetric,
+    ) -> (usize, bool) {
+        if pop.is_empty() {
+            return (0, false);
+        }
+        let own: Vec<[f64; 3]> = self.places.iter().map(|p| p.pose).collect();
+        let mut own_costs = vec![0.0; own.len()];
+        range_costs(map, beams, metric, &own, &mut own_costs);
+        let start = self.places.iter().map(|p| p.sum).reduce(f64::min);
+        let mut member: Vec<Option<usize>> = Vec::with_capacity(MAX_PLACES);
+        let mut costs: Vec<f64> = Vec::with_capacity(MAX_PLACES);
+        for (p, &c) in self.places.iter_mut().zip(&own_costs) {
+            let near = nearest_best(pop, &p.pose);
+            match near {
+                Some(i) if pop.costs[i] < c => {
+                    p.pose = pop.poses[i];
+                    member.push(Some(i));
+                    costs.push(pop.costs[i]);
+                }
+                _ => {
+                    member.push(None);
+                    costs.push(c);
+                }
+            }
+        }
+        // members in order of cost, each starting a place if away from every known one
+        let mut order: Vec<usize> = (0..pop.len()).collect();
+        order.sort_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(a.cmp(&b)));
+        let newcomer = start.map_or(0.0, |s| s + SETTLED);
+        for i in order {
+            let best = costs
+                .iter()
+                .copied()
+                .reduce(f64::min)
+                .unwrap_or(pop.costs[i]);
+            if self.places.len() >= 2 * MAX_PLACES || pop.costs[i] > PLAUSIBLE * best {
+                break;
+            }
+            let p = pop.poses[i];
+            if self
+                .places
+                .iter()
+                .any(|q| close(&p, &q.pose, RADIUS, ANGLE))
+            {
+                continue;
+            }
+            self.places.push(Place {
+                pose: p,
+                sum: newcomer,
+            });
+            member.push(Some(i));
+            costs.push(pop.costs[i]);
+        }
+        for (p, c) in self.places.iter_mut().zip(&costs) {
+            p.sum += c;
+        }
+        let mut ranked: Vec<usize> = (0..self.places.len()).collect();
+        ranked.sort_by(|&a, &b| {
+            let (pa, pb) = (&self.places[a], &self.places[b]);
+            pa.sum.total_cmp(&pb.sum).then(a.cmp(&b))
+        });
+        let Some(best_sum) = ranked.first().map(|&k| self.places[k].sum) else {
+            return (pop.best(), false);
+        };
+        let mut kept: Vec<(Place, Option<usize>, f64)> = Vec::with_capacity(MAX_PLACES);
+        for k in ranked {
+            let p = self.places[k];
+            if kept.len() == MAX_PLACES || p.sum > best_sum + DROP {
+                break;
+            }
+            // two places that drifted together are one: the better sum stays
+            if kept
+                .iter()
+                .any(|q| close(&p.pose, &q.0.pose, RADIUS, ANGLE))
+            {
+                continue;
+            }
+            kept.push((p, member[k], costs[k]));
+        }
+        self.places = kept.iter().map(|k| k.0).collect();
+        let settled = self
+            .places
+            .get(1)
+            .is_none_or(|q| q.sum - best_sum >= SETTLED);
+        let Some(&(first, at, cost)) = kept.first() else {
+            return (pop.best(), false);
+        };
+        let lead = match at {
+            Some(i) => i,
+            None => {
+                // no member near the best place: it takes the worst member's slot
+                let worst = (0..pop.len())
+                    .max_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(b.cmp(&a)))
+                    .unwrap_or(0);
+                pop.poses[worst] = first.pose;
+                pop.costs[worst] = cost;
+                worst
+            }
+        };
+        (lead, settled)
+    }
+}
+
+/// The member of lowest cost within a place's reach of `pose`.
+fn nearest_best(pop: &Population, pose: &[f64; 3]) -> Option<usize> {
+    (0..pop.len())
+        .filter(|&i| close(&pop.poses[i], pose, RADIUS, ANGLE))
+        .min_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(a.cmp(&b)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::stream_rng;
+    use crate::localization::test_drive::{hospital, scan_at};
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// Where r4 of the patrol starts, facing west along the north corridor, and the same spot of
+    /// the look-alike wing 27 m west.
+    const TRUTH: [f64; 3] = [61.8, 24.75, std::f64::consts::PI];
+    const TWIN: [f64; 3] = [34.8, 24.75, std::f64::consts::PI];
+
+    /// A laser five times noisier than the LMS100 (or a crowd in view).
+    const NOISE: f64 = 0.06;
+
+    /// Driving west from the start, the robot's place and its twin fit the first scans alike: the
+    /// places do not settle on them, and once the scans tell them apart (after about 2.5 m) the
+    /// robot's place leads by [`SETTLED`], the estimate follows it and the twin is dropped.
+    #[test]
+    fn look_alike_places_settle_only_once_the_scans_tell_them_apart() {
+        let map = hospital();
+        let mut rng = stream_rng(2, "test", "places");
+        let mut pop = Population {
+            poses: vec![TWIN, TRUTH, [10.0, 7.0, 0.0]],
+            costs: vec![0.0; 3],
+        };
+        let mut places = Places::default();
+        let step = Pose2::new(0.25, 0.0, 0.0);
+        let mut truth = Pose2::new(TRUTH[0], TRUTH[1], TRUTH[2]);
+        let mut settled_at = None;
+        for k in 0..40 {
+            if k > 0 {
+                truth = truth.compose(&step);
+                places.carry(&step);
+                for p in &mut pop.poses {
+                    let q = Pose2::new(p[0], p[1], p[2]).compose(&step);
+                    *p = [q.x, q.y, q.theta];
+                }
+            }
+            let mut scan = scan_at(&map, &truth, &mut rng);
+            for r in scan.ranges.iter_mut().filter(|r| r.is_finite()) {
+                let e: f64 = StandardNormal.sample(&mut rng);
+                *r += NOISE as f32 * e as f32;
+            }
+            let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60);
+            pop.evaluate(&map, &beams, RangeMetric::L1);
+            if k == 0 {
+                // the twin is a look-alike: it fits the first scan about as well
+                assert!(pop.costs[0] < PLAUSIBLE * pop.costs[1], "{:?}", pop.costs);
+            }
+            let (lead, settled) = places.update(&mut pop, &map, &beams, RangeMetric::L1);
+            assert!(places.len() <= 2, "update {k}");
+            if k == 0 {
+                assert!(places.len() == 2 && !settled);
+            }
+            if settled && settled_at.is_none() {
+                settled_at = Some(k);
+            }
+            if settled {
+                let at = Pose2::new(pop.poses[lead][0], pop.poses[lead][1], pop.poses[lead][2]);
+                assert!(at.distance(&truth) < 0.1, "update {k}: {at:?} {truth:?}");
+            }
+        }
+        // the corridors look alike for the first 2.5 m
+        let k = settled_at.expect("never settled");
+        assert!((5..=20).contains(&k), "settled after {k} updates");
+        assert_eq!(places.len(), 1, "the twin is dropped once far behind");
+    }
+}
