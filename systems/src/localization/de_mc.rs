@@ -55,8 +55,9 @@ pub struct DeMcConfig {
     pub refine_sd: [f64; 3],
     /// While the filter searches (not converged), the worst members are replaced at every
     /// update by poses drawn from the scan, as Mixture MCL's dual proposal does
-    /// ([`super::mcl::injection`]): this many candidates per round (0: off, the default; unlike
-    /// the DE filter's, the chains' convergence did not get faster with it).
+    /// ([`super::mcl::injection`]): this many candidates per round (0: off, the thesis's
+    /// filter). Together with the weighing of look-alike places over several scans
+    /// ([`super::de_places`]) it puts the true place among the chains from the first scans.
     pub injection_candidates: usize,
 }
 
@@ -80,7 +81,7 @@ impl Default for DeMcConfig {
             refine_rounds: 4,
             refine_samples: 32,
             refine_sd: [0.2, 0.2, 0.05],
-            injection_candidates: 0,
+            injection_candidates: 20_000,
         }
     }
 }
