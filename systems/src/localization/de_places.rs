@@ -1,6 +1,6 @@
 //! The look-alike places a searching DE localizer weighs over several scans before it commits to
-//! one (multiple-hypothesis tracking, [Jensfelt 2001]). The hospital's wards repeat every 27 m:
-//! from the ward corridor, one scan fits the robot's ward and its twin almost alike, and a filter
+//! one (multiple-hypothesis tracking, [Jensfelt 2001]). The hospital's wings repeat every 27 m:
+//! from a ward's corridor, one scan fits the robot's ward and its twin almost alike, and a filter
 //! that followed the best member of each scan could settle on the twin and hold it for tens of
 //! seconds. Here every distinct place the population finds plausible is carried by the odometry
 //! and sums its cost (mean range error) over the scans since it was found; the estimate follows
