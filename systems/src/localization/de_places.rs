@@ -169,9 +169,7 @@ impl Places {
             Some(i) => i,
             None => {
                 // no member near the best place: it takes the worst member's slot
-                let worst = (0..pop.len())
-                    .max_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(b.cmp(&a)))
-                    .unwrap_or(0);
+                let worst = pop.worst();
                 pop.poses[worst] = first.pose;
                 pop.costs[worst] = cost;
                 worst

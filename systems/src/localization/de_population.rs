@@ -163,6 +163,13 @@ impl Population {
             .unwrap_or(0)
     }
 
+    /// Index of the worst member (highest cost, first on ties).
+    pub fn worst(&self) -> usize {
+        (0..self.costs.len())
+            .max_by(|&a, &b| self.costs[a].total_cmp(&self.costs[b]).then(b.cmp(&a)))
+            .unwrap_or(0)
+    }
+
     /// The member the estimate follows: with a `gate` (a tracking filter's prediction), the
     /// member within the gate of lowest cost weighed by the gate's prior, so the estimate does
     /// not jump to a look-alike place that fits one scan as well (the filter's convergence
@@ -189,9 +196,7 @@ impl Population {
             && !close(&self.poses[lead], &g.centre, g.radius, g.angle)
             && !self.is_empty()
         {
-            let worst = (0..self.len())
-                .max_by(|&a, &b| self.costs[a].total_cmp(&self.costs[b]).then(b.cmp(&a)))
-                .unwrap_or(0);
+            let worst = self.worst();
             self.poses[worst] = elite.0;
             self.costs[worst] = elite.1;
             return worst;

@@ -48,9 +48,6 @@ impl MarkovGrid {
             .iter()
             .map(|p| (p[0] as f64).hypot(p[1] as f64))
             .fold(0.0, f64::max);
-        if self.field.as_ref().is_none_or(|f| f.reach < reach) {
-            self.field = Some(PaddedField::new(&map.field, reach.max(1.0)));
-        }
         let laser = self.config.laser;
         let tables: Vec<[f32; 256]> = points
             .iter()
@@ -69,7 +66,11 @@ impl MarkovGrid {
         if self.sample.is_empty() {
             self.sample = sample_cells(&self.layout);
         }
-        let field = self.field.as_ref().expect("built above");
+        // the padded field, rebuilt when the scan reaches farther than it was built for
+        let field = match &mut self.field {
+            Some(f) if f.reach >= reach => &*f,
+            slot => &*slot.insert(PaddedField::new(&map.field, reach.max(1.0))),
+        };
         let layout = &self.layout;
         let (sample, sub) = (&self.sample, &self.sub_cell);
         let sampled: Vec<Vec<f32>> = self
