@@ -168,6 +168,7 @@ impl DeTracker {
             &beams.returns(),
             beams.range_max,
             n,
+            n,
             &mut self.rng,
         );
         let p = &mut self.population;

@@ -8,7 +8,7 @@
 //! p(z | x) cannot be sampled directly on a map, so it is approximated by a short search:
 //! `n` uniform free poses are scored on a widened likelihood field (σ ≥ [`WIDE_SIGMA`], so poses
 //! a metre off still rank well); the best [`KEEP`] — at most [`PER_BIN`] per 1 m × 1 m × 30°
-//! bin, so several look-alike places survive — each spawn `n / KEEP` jittered copies, scored
+//! bin, so several look-alike places survive — each spawn `refine_n / KEEP` jittered copies, scored
 //! again, for [`ROUNDS`] rounds of halving jitter, the last on the filter's own likelihood
 //! field. The [`KEEP`] survivors are the proposal; the filter's weighting decides between them.
 
@@ -27,11 +27,19 @@ pub const KEEP: usize = 64;
 pub const PER_BIN: usize = 4;
 /// Refinement rounds after the uniform draw.
 pub const ROUNDS: usize = 3;
+/// MCL's refinement rounds score `n / MCL_REFINE_FRACTION` candidates: its particles weigh
+/// the proposal's poses again at every update, so a coarser search serves it; the DE filter
+/// puts only the few best poses in its population and refines with all `n`.
+pub const MCL_REFINE_FRACTION: usize = 4;
 /// Jitter of the first refinement round (m, m, rad); halved every round.
 const JITTER: [f64; 3] = [0.4, 0.4, 0.15];
+/// Candidates ordered at a time when picking the kept ones: usually enough, and selecting
+/// them costs a pass where sorting all costs a sort.
+const SELECT_BLOCK: usize = 1024;
 
-/// Up to [`KEEP`] poses (x, y, θ) that explain the scan endpoints `points` (base frame); `n`
-/// candidates per round.
+/// Up to [`KEEP`] poses (x, y, θ) that explain the scan endpoints `points` (base frame): `n`
+/// uniform candidates, then about `refine_n` per refinement round.
+#[allow(clippy::too_many_arguments)]
 pub fn scan_proposal(
     map: &LocalizationMap,
     laser: &LaserModelParams,
@@ -39,6 +47,7 @@ pub fn scan_proposal(
     points: &[[f32; 2]],
     range_max: f32,
     n: usize,
+    refine_n: usize,
     rng: &mut SimRng,
 ) -> Vec<(f64, f64, f64)> {
     if points.is_empty() || n == 0 {
@@ -49,14 +58,9 @@ pub fn scan_proposal(
         ..*laser
     };
     let wide = likelihood_table(&map.field, &wide_params, range_max as f64);
-    let mut cand: Vec<[f64; 3]> = (0..n)
-        .map(|_| {
-            let (x, y, t) = map.random_free_pose(&mut || rng.random::<f64>());
-            [x, y, t]
-        })
-        .collect();
+    let mut cand = map.random_free_poses(n, &mut || rng.random::<f64>());
     let mut kept = best_distinct(map, &wide, points, &cand);
-    let per = n.div_ceil(kept.len().max(1));
+    let per = refine_n.max(1).div_ceil(kept.len().max(1));
     for round in 0..ROUNDS {
         let sd = JITTER.map(|v| v / f64::from(1u32 << round));
         cand.clear();
@@ -89,29 +93,114 @@ fn best_distinct(
     let ths: Vec<f64> = cand.iter().map(|c| c[2]).collect();
     let mut score = vec![1.0; cand.len()];
     weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+    // best first, ties by index: a total order, so sorting the best block after selecting it
+    // gives the order of a full sort, block by block, until enough are kept
+    let better = |a: &usize, b: &usize| score[*b].total_cmp(&score[*a]).then(a.cmp(b));
     let mut order: Vec<usize> = (0..cand.len()).collect();
-    order.sort_by(|&a, &b| score[b].total_cmp(&score[a]).then(a.cmp(&b)));
     let mut per_bin: HashMap<(i64, i64, i64), usize> = HashMap::new();
     let mut kept = Vec::with_capacity(KEEP);
-    for i in order {
-        let c = cand[i];
-        if !map.is_free(c[0], c[1]) {
-            continue;
+    let mut rest = &mut order[..];
+    while kept.len() < KEEP && !rest.is_empty() {
+        let m = SELECT_BLOCK.min(rest.len());
+        if m < rest.len() {
+            rest.select_nth_unstable_by(m - 1, better);
         }
-        let bin = (
-            c[0].floor() as i64,
-            c[1].floor() as i64,
-            (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
-        );
-        let count = per_bin.entry(bin).or_insert(0);
-        if *count >= PER_BIN {
-            continue;
+        let (block, tail) = rest.split_at_mut(m);
+        block.sort_unstable_by(better);
+        for &i in block.iter() {
+            let c = cand[i];
+            if !map.is_free(c[0], c[1]) {
+                continue;
+            }
+            let bin = (
+                c[0].floor() as i64,
+                c[1].floor() as i64,
+                (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
+            );
+            let count = per_bin.entry(bin).or_insert(0);
+            if *count >= PER_BIN {
+                continue;
+            }
+            *count += 1;
+            kept.push(c);
+            if kept.len() == KEEP {
+                break;
+            }
         }
-        *count += 1;
-        kept.push(c);
-        if kept.len() == KEEP {
-            break;
-        }
+        rest = tail;
     }
     kept
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::{Pose2, stream_rng};
+    use crate::localization::fixtures::{CORRIDOR, hospital, scan_at};
+
+    /// [`best_distinct`] with every candidate sorted at once.
+    fn best_distinct_plain(
+        map: &LocalizationMap,
+        table: &[f32; 256],
+        points: &[[f32; 2]],
+        cand: &[[f64; 3]],
+    ) -> Vec<[f64; 3]> {
+        let xs: Vec<f64> = cand.iter().map(|c| c[0]).collect();
+        let ys: Vec<f64> = cand.iter().map(|c| c[1]).collect();
+        let ths: Vec<f64> = cand.iter().map(|c| c[2]).collect();
+        let mut score = vec![1.0; cand.len()];
+        weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+        let mut order: Vec<usize> = (0..cand.len()).collect();
+        order.sort_by(|&a, &b| score[b].total_cmp(&score[a]).then(a.cmp(&b)));
+        let mut per_bin: HashMap<(i64, i64, i64), usize> = HashMap::new();
+        let mut kept = Vec::new();
+        for i in order {
+            let c = cand[i];
+            let bin = (
+                c[0].floor() as i64,
+                c[1].floor() as i64,
+                (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
+            );
+            if map.is_free(c[0], c[1]) && *per_bin.get(&bin).unwrap_or(&0) < PER_BIN {
+                *per_bin.entry(bin).or_insert(0) += 1;
+                kept.push(c);
+                if kept.len() == KEEP {
+                    break;
+                }
+            }
+        }
+        kept
+    }
+
+    /// Picking from the best block at a time keeps exactly the candidates, in the order, that
+    /// sorting them all does: with uniform draws, with thousands crowding the true pose's bin
+    /// (so later blocks are needed), and with repeated candidates whose scores tie.
+    #[test]
+    fn picking_block_by_block_keeps_what_a_full_sort_keeps() {
+        let map = hospital();
+        let mut rng = stream_rng(5, "test", "injection");
+        let truth = Pose2::new(CORRIDOR[0][0] + 4.0, CORRIDOR[0][1], 0.1);
+        let scan = scan_at(&map, &truth, &mut rng);
+        let points: Vec<[f32; 2]> = scan.points().step_by(18).collect();
+        let table = likelihood_table(&map.field, &LaserModelParams::default(), 20.0);
+        let mut cand = map.random_free_poses(5000, &mut || rng.random::<f64>());
+        for _ in 0..3000 {
+            let mut g = || -> f64 { StandardNormal.sample(&mut rng) };
+            cand.push([
+                truth.x + 0.05 * g(),
+                truth.y + 0.05 * g(),
+                truth.theta + 0.02 * g(),
+            ]);
+        }
+        let repeated: Vec<[f64; 3]> = cand[5000..5400].to_vec();
+        cand.extend(repeated);
+        let kept = best_distinct(&map, &table, &points, &cand);
+        assert_eq!(kept.len(), KEEP);
+        assert_eq!(kept, best_distinct_plain(&map, &table, &points, &cand));
+        let few = &cand[..700];
+        assert_eq!(
+            best_distinct(&map, &table, &points, few),
+            best_distinct_plain(&map, &table, &points, few)
+        );
+    }
 }

@@ -370,6 +370,7 @@ impl Mcl {
             &beams.returns(),
             beams.range_max,
             n,
+            n / injection::MCL_REFINE_FRACTION,
             &mut self.rng,
         );
         (!pool.is_empty()).then_some(pool)
@@ -483,6 +484,7 @@ impl Mcl {
             &points,
             beams.range_max,
             n,
+            n / injection::MCL_REFINE_FRACTION,
             &mut self.rng,
         );
         if searching {
