@@ -12,6 +12,7 @@ use crate::core::{KernelPool, Pose2};
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// One localization algorithm with its state.
 #[derive(Clone, Debug)]
@@ -225,8 +226,8 @@ impl Localizer {
         let Filter::Map(f) = &mut self.filter else {
             return false;
         };
-        let beams = scan.beams(f.max_beams());
-        if !beams.has_returns() {
+        let max_beams = f.max_beams();
+        if !scan.has_returns(max_beams) {
             // no usable beam (a laser sending NaN, zeros or nothing but its maximum range):
             // degraded as while the laser is faulted, rather than a confident estimate the
             // scan never confirmed
@@ -235,7 +236,7 @@ impl Localizer {
         }
         self.degraded = false;
         if f.predict(odom)
-            && f.correct(map, beams)
+            && f.correct(map, scan.beams(max_beams))
             && let Some(e) = f.estimate()
         {
             self.anchor = Some(Anchor::new(e, *odom));
@@ -267,27 +268,47 @@ impl Localizer {
     }
 }
 
-/// A scan with its beam subsets, built once per distinct beam count.
+/// A scan with its beam subsets per distinct beam count: whether each has returns, checked for
+/// every scan, and the subset itself, built once by the first filter that updates on it (most
+/// scans update none: the filters wait for enough motion).
 struct ScanInput<'a> {
     scan: &'a crate::sensors::LaserScan,
     mount: Pose2,
-    subsets: Vec<(usize, BeamSubset)>,
+    subsets: Vec<Subset>,
+}
+
+struct Subset {
+    max_beams: usize,
+    has_returns: bool,
+    beams: OnceLock<BeamSubset>,
 }
 
 impl ScanInput<'_> {
     fn prepare(&mut self, max_beams: usize) {
-        if !self.subsets.iter().any(|(m, _)| *m == max_beams) {
-            let s = BeamSubset::from_scan(self.scan, &self.mount, max_beams);
-            self.subsets.push((max_beams, s));
+        if !self.subsets.iter().any(|s| s.max_beams == max_beams) {
+            self.subsets.push(Subset {
+                max_beams,
+                has_returns: BeamSubset::scan_has_returns(self.scan, max_beams),
+                beams: OnceLock::new(),
+            });
         }
     }
 
-    fn beams(&self, max_beams: usize) -> &BeamSubset {
+    fn subset(&self, max_beams: usize) -> &Subset {
         self.subsets
             .iter()
-            .find(|(m, _)| *m == max_beams)
-            .map(|(_, s)| s)
+            .find(|s| s.max_beams == max_beams)
             .expect("subsets are prepared before use")
+    }
+
+    fn has_returns(&self, max_beams: usize) -> bool {
+        self.subset(max_beams).has_returns
+    }
+
+    fn beams(&self, max_beams: usize) -> &BeamSubset {
+        self.subset(max_beams)
+            .beams
+            .get_or_init(|| BeamSubset::from_scan(self.scan, &self.mount, max_beams))
     }
 }
 

@@ -72,27 +72,12 @@ pub struct BeamSubset {
 
 impl BeamSubset {
     pub fn from_scan(scan: &LaserScan, mount: &Pose2, max_beams: usize) -> Self {
-        let n = scan.ranges.len();
         let mut s = BeamSubset {
             mount: *mount,
             range_max: scan.range_max,
             ..Default::default()
         };
-        if n == 0 || max_beams == 0 {
-            return s;
-        }
-        let picks = max_beams.min(n);
-        let step = if picks > 1 {
-            (n - 1) as f64 / (picks - 1) as f64
-        } else {
-            0.0
-        };
-        for j in 0..picks {
-            let k = ((j as f64 * step).round() as usize).min(n - 1);
-            let r = scan.ranges[k];
-            if r.is_nan() || r < scan.range_min.max(0.0) {
-                continue;
-            }
+        for (k, r) in picked(scan, max_beams) {
             let max_reading = r == f32::INFINITY || r >= scan.range_max;
             let r = if max_reading { scan.range_max } else { r };
             let a = scan.angle_min as f64 + k as f64 * scan.angle_increment as f64;
@@ -103,6 +88,12 @@ impl BeamSubset {
             s.points.push([p[0] as f32, p[1] as f32]);
         }
         s
+    }
+
+    /// `BeamSubset::from_scan(scan, _, max_beams).has_returns()` without building the subset:
+    /// a scan that does not update a filter is still checked for returns at every scan.
+    pub fn scan_has_returns(scan: &LaserScan, max_beams: usize) -> bool {
+        picked(scan, max_beams).any(|(_, r)| r != f32::INFINITY && r < scan.range_max)
     }
 
     pub fn len(&self) -> usize {
@@ -129,6 +120,22 @@ impl BeamSubset {
     pub fn has_returns(&self) -> bool {
         self.max_reading.iter().any(|max| !max)
     }
+}
+
+/// The beams of [`BeamSubset::from_scan`]: index and reading of every picked beam that is kept
+/// (not NaN, not below the minimum range).
+fn picked(scan: &LaserScan, max_beams: usize) -> impl Iterator<Item = (usize, f32)> + '_ {
+    let n = scan.ranges.len();
+    let picks = if n == 0 { 0 } else { max_beams.min(n) };
+    let step = if picks > 1 {
+        (n - 1) as f64 / (picks - 1) as f64
+    } else {
+        0.0
+    };
+    (0..picks)
+        .map(move |j| ((j as f64 * step).round() as usize).min(n - 1))
+        .map(|k| (k, scan.ranges[k]))
+        .filter(|&(_, r)| !(r.is_nan() || r < scan.range_min.max(0.0)))
 }
 
 /// The likelihood-field score table: pz³ per stored distance byte.

@@ -351,6 +351,19 @@ mod props {
                 prop_assert!(b.points[k].iter().all(|v| v.is_finite()));
             }
         }
+
+        /// The check every scan gets tells what the subset it spares would have told.
+        #[test]
+        fn a_scan_has_returns_exactly_when_its_beam_subset_has(
+            ranges in proptest::collection::vec(range_reading(10.0), 0..120),
+            max_beams in 0usize..80,
+        ) {
+            let scan = garbage_scan(ranges);
+            prop_assert_eq!(
+                BeamSubset::scan_has_returns(&scan, max_beams),
+                BeamSubset::from_scan(&scan, &Pose2::IDENTITY, max_beams).has_returns()
+            );
+        }
     }
 
     proptest! {
