@@ -108,6 +108,40 @@ pub fn cell_log_likelihood(
         .sum()
 }
 
+/// [`cell_log_likelihood`] of each cell (i, j) of `cells`, into `out`: eight cells at a time,
+/// beam by beam, so the eight reads of the field at each beam overlap (the cells lie far apart,
+/// each read a likely cache miss); each cell's sum still adds its beams in order.
+pub fn cells_log_likelihood(
+    field: &PaddedField,
+    tables: &[[f32; 256]],
+    layout: &Layout,
+    offsets: &[isize],
+    cells: &[(u32, u32)],
+    out: &mut Vec<f32>,
+) {
+    const GROUP: usize = 8;
+    let (pad, w) = (field.pad as isize, field.width as isize);
+    let centre = |&(i, j): &(u32, u32)| {
+        (layout.fine_row[j as usize] as isize + pad) * w
+            + pad
+            + layout.fine_col[i as usize] as isize
+    };
+    let (groups, rest) = cells.as_chunks::<GROUP>();
+    for g in groups {
+        let centres = g.each_ref().map(centre);
+        let mut acc = [-0.0f32; GROUP];
+        for (&o, table) in offsets.iter().zip(tables) {
+            for (a, &c) in acc.iter_mut().zip(&centres) {
+                *a += table[field.cells[(c + o) as usize] as usize];
+            }
+        }
+        out.extend_from_slice(&acc);
+    }
+    out.extend(rest.iter().map(|&(i, j)| {
+        cell_log_likelihood(field, tables, layout, offsets, i as usize, j as usize)
+    }));
+}
+
 /// The log-likelihood table of a beam of length `range` (m): ln(z_hit·exp(−d²/2σ_b²) + z_rand/z_max)
 /// per stored distance byte, σ_b widened for the cell's extent (module docs).
 pub fn beam_table(

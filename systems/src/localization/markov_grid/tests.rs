@@ -56,6 +56,37 @@ fn layer_score_matches_a_direct_evaluation() {
     assert!(own > at(i + 4, j, k) && own > at(i, j, (k + 3) % l.n_theta));
 }
 
+/// The selective update's sample cells, scored eight at a time, score exactly what the
+/// layer kernel gives those cells when it scores every cell.
+#[test]
+fn sample_cells_score_what_the_whole_layer_scores() {
+    let map = hospital();
+    let mut grid = MarkovGrid::new(MarkovGridConfig::default(), &map);
+    let mut rng = stream_rng(2, "test", "grid-score");
+    let scan = scan_at(&map, &Pose2::new(30.0, 24.75, 2.0), &mut rng);
+    let pts = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60).returns();
+    grid.score(&map, &pts, 20.0, None);
+    let full = &grid.scratch.clone();
+    let none: Vec<Vec<Span>> = vec![Vec::new(); grid.layout.n_theta];
+    let sampled = grid.score(&map, &pts, 20.0, Some(&none));
+    let l = &grid.layout;
+    let expected: Vec<f32> = grid
+        .sample
+        .iter()
+        .enumerate()
+        .flat_map(|(k, cells)| {
+            cells
+                .iter()
+                .map(move |&(i, j)| full[k * l.layer() + j as usize * l.nx + i as usize])
+        })
+        .collect();
+    assert!(grid.sample.iter().any(|c| c.len() % 8 != 0));
+    assert_eq!(sampled.len(), expected.len());
+    for (a, b) in sampled.iter().zip(&expected) {
+        assert_eq!(a.to_bits(), b.to_bits(), "{a} against {b}");
+    }
+}
+
 /// Prediction keeps the mass (away from walls) and carries a peak along the motion.
 #[test]
 fn prediction_moves_the_mass_with_the_robot() {

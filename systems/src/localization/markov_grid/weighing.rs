@@ -97,14 +97,11 @@ impl MarkovGrid {
                 if active.is_none() {
                     return Vec::new();
                 }
-                sample[k]
-                    .iter()
-                    .map(|&(i, j)| {
-                        correction::cell_log_likelihood(
-                            field, &tables, layout, &offsets, i as usize, j as usize,
-                        )
-                    })
-                    .collect()
+                let mut v = Vec::with_capacity(sample[k].len());
+                correction::cells_log_likelihood(
+                    field, &tables, layout, &offsets, &sample[k], &mut v,
+                );
+                v
             })
             .collect();
         sampled.concat()
