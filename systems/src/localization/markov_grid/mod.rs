@@ -83,7 +83,9 @@ impl Default for MarkovGridConfig {
             // tens of nats and it jumped to a look-alike ward 23–36 m away [Thrun 2005, §6.4.3]
             likelihood_exponent: 0.3,
             uniform_mix: 1e-6,
-            update_min_d: 0.25,
+            // every 1.6 cells of travel: a pass over the whole belief per update is most of
+            // the filter's cost, and a scan per cell of travel converged no better
+            update_min_d: 0.4,
             update_min_a: 10f64.to_radians(),
             init: InitialBelief::Global,
             selective_threshold: 1e-6,
