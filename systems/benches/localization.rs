@@ -20,7 +20,8 @@ use systems::localization::de_filter::{DeFilter, DeFilterConfig};
 use systems::localization::fixtures::{
     CORRIDOR, DriveStep, bench_markov_grid, bench_mcl, hospital, recorded_drive,
 };
-use systems::localization::markov_grid::belief_ops;
+use systems::localization::markov_grid::layout::Layout;
+use systems::localization::markov_grid::{belief_ops, prediction};
 use systems::localization::mcl::field_kernel::{self, GridPose};
 use systems::localization::mcl::{BeamSubset, sensor_model};
 use systems::localization::{LocalizationMap, MarkovGrid};
@@ -266,9 +267,38 @@ fn belief_passes(c: &mut Criterion) {
     g.finish();
 }
 
+/// The Markov grid's motion blurs over the hospital's belief (0.25 m × 10°), with the 3-tap
+/// kernel of a quarter cell² (most blurs) and a 7-tap one.
+fn blurs(c: &mut Criterion, map: &LocalizationMap) {
+    let l = Layout::new(&map.grid, 0.25, 36);
+    let src: Vec<f32> = (0..l.len())
+        .map(|c| if l.free[c % l.layer()] { 1e-6 } else { 0.0 })
+        .collect();
+    let mut out = src.clone();
+    let mut g = c.benchmark_group("markov_grid_blur");
+    for variance in [0.25, 1.0] {
+        let k = prediction::kernel_of_variance(variance);
+        g.bench_with_input(BenchmarkId::new("xy", k.len()), &k, |b, k| {
+            b.iter(|| {
+                out.copy_from_slice(&src);
+                prediction::blur_xy(&l, k, &mut out);
+                black_box(out[0])
+            })
+        });
+        g.bench_with_input(BenchmarkId::new("theta", k.len()), &k, |b, k| {
+            b.iter(|| {
+                prediction::blur_theta(&l, k, &src, &mut out);
+                black_box(out[0])
+            })
+        });
+    }
+    g.finish();
+}
+
 fn localization(c: &mut Criterion) {
     belief_passes(c);
     let map = hospital();
+    blurs(c, &map);
     let steps = recorded_drive(&map, &CORRIDOR, 0.0, 1);
     let beams = subsets(&steps);
     mcl(c, &map, &steps, &beams);

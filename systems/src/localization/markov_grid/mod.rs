@@ -106,7 +106,6 @@ pub struct MarkovGrid {
     /// What the pass that last wrote the belief found that the next one needs.
     carried: Option<Carried>,
     scratch: Vec<f32>,
-    tmp: Vec<f32>,
     field: Option<PaddedField>,
     /// Per θ layer, the (i, j) cells whose mean likelihood stands for the floor's in the
     /// selective update (built at the first correction).
@@ -146,7 +145,6 @@ impl MarkovGrid {
             pending_noise: [0.0; 2],
             carried: None,
             scratch: vec![0.0; layout.len()],
-            tmp: Vec::new(),
             sample: Vec::new(),
             layout,
             config,
@@ -279,7 +277,7 @@ impl MarkovGrid {
         self.pending_noise[1] = (self.pending_noise[1] + th).min(cap(l.n_theta));
         if self.pending_noise[0] >= BLUR_VARIANCE {
             let k = prediction::kernel_of_variance(self.pending_noise[0]);
-            prediction::blur_xy(&self.layout, &k, &mut self.belief, &mut self.tmp);
+            prediction::blur_xy(&self.layout, &k, &mut self.belief);
             self.pending_noise[0] = 0.0;
             tally = belief_ops::Tally::default();
             tally.add(&self.belief);
