@@ -8,9 +8,10 @@
 //! p(z | x) cannot be sampled directly on a map, so it is approximated by a short search:
 //! `n` uniform free poses are scored on a widened likelihood field (σ ≥ [`WIDE_SIGMA`], so poses
 //! a metre off still rank well); the best [`KEEP`] — at most [`PER_BIN`] per 1 m × 1 m × 30°
-//! bin, so several look-alike places survive — each spawn `refine_n / KEEP` jittered copies, scored
-//! again, for [`ROUNDS`] rounds of halving jitter, the last on the filter's own likelihood
-//! field. The [`KEEP`] survivors are the proposal; the filter's weighting decides between them.
+//! bin, so several look-alike places survive — each spawn `refine_n / KEEP` jittered copies,
+//! scored again, for [`ROUNDS`] rounds of halving jitter, the last on the filter's own
+//! likelihood field. The [`KEEP`] survivors are the proposal; the filter's weighting decides
+//! between them.
 
 use super::sensor_model::{LaserModelParams, likelihood_table, weigh_likelihood_field};
 use crate::core::{SimRng, wrap_angle};
@@ -81,6 +82,15 @@ pub fn scan_proposal(
     kept.into_iter().map(|p| (p[0], p[1], p[2])).collect()
 }
 
+/// The 1 m × 1 m × 30° bin of a candidate.
+fn bin_of(c: &[f64; 3]) -> (i64, i64, i64) {
+    (
+        c[0].floor() as i64,
+        c[1].floor() as i64,
+        (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
+    )
+}
+
 /// The best-scoring [`KEEP`] candidates on free cells, at most [`PER_BIN`] per bin.
 fn best_distinct(
     map: &LocalizationMap,
@@ -112,11 +122,7 @@ fn best_distinct(
             if !map.is_free(c[0], c[1]) {
                 continue;
             }
-            let bin = (
-                c[0].floor() as i64,
-                c[1].floor() as i64,
-                (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
-            );
+            let bin = bin_of(&c);
             let count = per_bin.entry(bin).or_insert(0);
             if *count >= PER_BIN {
                 continue;
@@ -156,11 +162,7 @@ mod tests {
         let mut kept = Vec::new();
         for i in order {
             let c = cand[i];
-            let bin = (
-                c[0].floor() as i64,
-                c[1].floor() as i64,
-                (c[2] / (std::f64::consts::PI / 6.0)).floor() as i64,
-            );
+            let bin = bin_of(&c);
             if map.is_free(c[0], c[1]) && *per_bin.get(&bin).unwrap_or(&0) < PER_BIN {
                 *per_bin.entry(bin).or_insert(0) += 1;
                 kept.push(c);
