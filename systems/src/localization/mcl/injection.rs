@@ -91,6 +91,21 @@ fn bin_of(c: &[f64; 3]) -> (i64, i64, i64) {
     )
 }
 
+/// The likelihood-field score of each candidate for the scan endpoints `points`.
+fn scores(
+    map: &LocalizationMap,
+    table: &[f32; 256],
+    points: &[[f32; 2]],
+    cand: &[[f64; 3]],
+) -> Vec<f64> {
+    let xs: Vec<f64> = cand.iter().map(|c| c[0]).collect();
+    let ys: Vec<f64> = cand.iter().map(|c| c[1]).collect();
+    let ths: Vec<f64> = cand.iter().map(|c| c[2]).collect();
+    let mut score = vec![1.0; cand.len()];
+    weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+    score
+}
+
 /// The best-scoring [`KEEP`] candidates on free cells, at most [`PER_BIN`] per bin.
 fn best_distinct(
     map: &LocalizationMap,
@@ -98,11 +113,7 @@ fn best_distinct(
     points: &[[f32; 2]],
     cand: &[[f64; 3]],
 ) -> Vec<[f64; 3]> {
-    let xs: Vec<f64> = cand.iter().map(|c| c[0]).collect();
-    let ys: Vec<f64> = cand.iter().map(|c| c[1]).collect();
-    let ths: Vec<f64> = cand.iter().map(|c| c[2]).collect();
-    let mut score = vec![1.0; cand.len()];
-    weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+    let score = scores(map, table, points, cand);
     // best first, ties by index: a total order, so sorting the best block after selecting it
     // gives the order of a full sort, block by block, until enough are kept
     let better = |a: &usize, b: &usize| score[*b].total_cmp(&score[*a]).then(a.cmp(b));
@@ -151,11 +162,7 @@ mod tests {
         points: &[[f32; 2]],
         cand: &[[f64; 3]],
     ) -> Vec<[f64; 3]> {
-        let xs: Vec<f64> = cand.iter().map(|c| c[0]).collect();
-        let ys: Vec<f64> = cand.iter().map(|c| c[1]).collect();
-        let ths: Vec<f64> = cand.iter().map(|c| c[2]).collect();
-        let mut score = vec![1.0; cand.len()];
-        weigh_likelihood_field(&map.field, table, points, &xs, &ys, &ths, &mut score);
+        let score = scores(map, table, points, cand);
         let mut order: Vec<usize> = (0..cand.len()).collect();
         order.sort_by(|&a, &b| score[b].total_cmp(&score[a]).then(a.cmp(&b)));
         let mut per_bin: HashMap<(i64, i64, i64), usize> = HashMap::new();
