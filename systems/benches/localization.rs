@@ -236,10 +236,10 @@ fn belief_passes(c: &mut Criterion) {
             black_box(t.sum())
         })
     });
-    g.bench_function("scale_below", |b| {
+    g.bench_function("weigh_and_mix", |b| {
         b.iter(|| {
             let mut t = belief_ops::Tally::default();
-            belief_ops::scale_below(&mut out, 5e-6, 1.0, &mut t);
+            belief_ops::weigh_and_mix(&mut out, &v, 5e-6, 1.0, [1.0, 1.0, 0.0], &mut t);
             black_box(t.sum())
         })
     });

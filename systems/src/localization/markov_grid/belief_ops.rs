@@ -125,38 +125,6 @@ pub fn runs_at_or_above(row: &[f32], threshold: f32, mut emit: impl FnMut(usize,
     }
 }
 
-/// Multiplies every value of `row` by `factor`, then calls `emit(start, len)` for every maximal
-/// run of the results at or above `threshold`: exactly [`scale`] then [`runs_at_or_above`], in
-/// one pass.
-pub fn scale_and_find_runs(
-    row: &mut [f32],
-    factor: f32,
-    threshold: f32,
-    mut emit: impl FnMut(usize, usize),
-) {
-    let n = row.len();
-    let mut start: Option<usize> = None;
-    let (blocks, rest) = row.as_chunks_mut::<RUN_BLOCK>();
-    let mut scale = |block: &mut [f32], at: usize, start: &mut Option<usize>| {
-        let mut above = 0usize;
-        for x in block.iter_mut() {
-            let y = *x * factor;
-            *x = y;
-            above += usize::from(y >= threshold);
-        }
-        runs_in_block(block, at, above, threshold, start, &mut emit);
-    };
-    let mut at = 0;
-    for b in blocks {
-        scale(b, at, &mut start);
-        at += RUN_BLOCK;
-    }
-    scale(rest, at, &mut start);
-    if let Some(s) = start {
-        emit(s, n - s);
-    }
-}
-
 /// The runs of one block of a row, which starts at `at` and has `above` values at or above
 /// `threshold`, `start` being where the run still open began: whole blocks below or above in one
 /// step, the others value by value.
@@ -225,14 +193,6 @@ fn map_tallied(v: &mut [f32], t: &mut Tally, f: impl Fn(f32) -> f32) {
     }
 }
 
-/// Multiplies every value of `v` below `threshold` by `factor` (the selective update's weight of
-/// the cells it does not score), tallying the results; values at or above it, and NaN, are left
-/// as they are.
-pub fn scale_below(v: &mut [f32], threshold: f32, factor: f32, t: &mut Tally) {
-    // a factor of 1 leaves a value as it is, NaN included
-    map_tallied(v, t, |x| x * if x < threshold { factor } else { 1.0 });
-}
-
 /// Multiplies every value of `v` by `factor`, tallying the results.
 pub fn scale(v: &mut [f32], factor: f32, t: &mut Tally) {
     map_tallied(v, t, |x| x * factor);
@@ -242,6 +202,39 @@ pub fn scale(v: &mut [f32], factor: f32, t: &mut Tally) {
 /// uniform mix in one pass, rounded as the two passes one after the other would be.
 pub fn scale_and_mix(v: &mut [f32], factor: f32, keep: f32, add: f32, t: &mut Tally) {
     map_tallied(v, t, |x| keep * (x * factor) + add);
+}
+
+/// The selective update's last pass: each value `x` of `v` at or above `threshold` (a cell it
+/// scored) becomes its weighed value, `scored`'s at the same place, each below it `x · floor`;
+/// then `keep · (y · factor) + add` with `[factor, keep, add]` = `scale`, tallied: rounded as
+/// the weighing then [`scale_and_mix`] one after the other would be.
+pub fn weigh_and_mix(
+    v: &mut [f32],
+    scored: &[f32],
+    threshold: f32,
+    floor: f32,
+    scale: [f32; 3],
+    t: &mut Tally,
+) {
+    let [factor, keep, add] = scale;
+    let f = |x: f32, w: f32| {
+        let y = if x >= threshold { w } else { x * floor };
+        keep * (y * factor) + add
+    };
+    let (wb, wr) = scored[..v.len()].as_chunks::<LANES>();
+    let (blocks, rest) = v.as_chunks_mut::<LANES>();
+    for (b, w) in blocks.iter_mut().zip(wb) {
+        for (lane, (x, &w)) in b.iter_mut().zip(w).enumerate() {
+            let y = f(*x, w);
+            *x = y;
+            t.lane(lane, y);
+        }
+    }
+    for (lane, (x, &w)) in rest.iter_mut().zip(wr).enumerate() {
+        let y = f(*x, w);
+        *x = y;
+        t.lane(lane, y);
+    }
 }
 
 /// [`f32::total_cmp`]'s order as integers.
@@ -311,17 +304,6 @@ mod tests {
                 runs_at_or_above(&v, threshold, |s, l| fast.push((s, l)));
                 runs_at_or_above_plain(&v, threshold, |s, l| plain.push((s, l)));
                 assert_eq!(fast, plain, "n {n}, threshold {threshold}");
-                // scaled, then the runs, in one pass
-                let (mut fused, mut scaled) = (v.clone(), v.clone());
-                let (mut fast, mut plain) = (Vec::new(), Vec::new());
-                scale_and_find_runs(&mut fused, 1.3, threshold, |s, l| fast.push((s, l)));
-                scale(&mut scaled, 1.3, &mut Tally::default());
-                runs_at_or_above_plain(&scaled, threshold, |s, l| plain.push((s, l)));
-                assert_eq!(
-                    (fused, fast),
-                    (scaled, plain),
-                    "n {n}, threshold {threshold}"
-                );
             }
         }
     }
@@ -350,13 +332,14 @@ mod tests {
     }
 
     #[test]
-    fn scale_below_leaves_the_scored_cells_and_nan() {
+    fn weigh_and_mix_takes_the_scored_cells_and_keeps_nan() {
         let mut v = vec![0.0, 1e-9, 0.5, 1.0, f32::NAN];
+        let scored = [9.0, 9.0, 0.125, 0.75, 9.0];
         let mut t = Tally::default();
-        scale_below(&mut v, 0.5, 0.25, &mut t);
-        assert_eq!(&v[..4], &[0.0, 0.25e-9, 0.5, 1.0]);
+        weigh_and_mix(&mut v, &scored, 0.5, 0.25, [2.0, 1.0, 0.0], &mut t);
+        assert_eq!(&v[..4], &[0.0, 0.5e-9, 0.25, 1.5]);
         assert!(v[4].is_nan());
-        assert_eq!(t.peak(), 1.0);
+        assert_eq!(t.peak(), 1.5);
     }
 
     /// The fused passes write what the plain passes do and tally what they wrote.
@@ -380,12 +363,34 @@ mod tests {
         let mut scaled = v.clone();
         scale(&mut scaled, f, &mut t);
         tallied(&t, &scaled);
+        // the selective update's last pass against the weighing, then the normalisation and mix
+        let scored: Vec<f32> = v.iter().map(|x| x * 0.3).collect();
         let mut t = Tally::default();
-        let mut below = v.clone();
-        scale_below(&mut below, 0.5, f, &mut t);
-        let plain: Vec<f32> = v.iter().map(|&x| if x < 0.5 { x * f } else { x }).collect();
-        assert_eq!(below, plain);
-        tallied(&t, &below);
+        let mut fused = v.clone();
+        weigh_and_mix(
+            &mut fused[..501],
+            &scored[..501],
+            0.5,
+            f,
+            [1.3, keep, add],
+            &mut t,
+        );
+        weigh_and_mix(
+            &mut fused[501..],
+            &scored[501..],
+            0.5,
+            f,
+            [1.3, keep, add],
+            &mut t,
+        );
+        let plain: Vec<f32> = v
+            .iter()
+            .zip(&scored)
+            .map(|(&x, &w)| if x >= 0.5 { w } else { x * f })
+            .map(|y| keep * (y * 1.3) + add)
+            .collect();
+        assert_eq!(fused, plain);
+        tallied(&t, &fused);
         let mut t = Tally::default();
         t.add(&v[..10]);
         t.add(&v[10..]);

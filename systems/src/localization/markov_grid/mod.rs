@@ -23,8 +23,10 @@
 //!
 //! Like MCL, it updates only after a minimum travel or turn of the odometry. Layers (θ) are
 //! scored in parallel; each layer's result depends on that layer only. The passes over the whole
-//! belief ([`belief_ops`]) each tally what the next one needs (sum, peak, the runs above the
-//! selective threshold), so an update passes over it five times.
+//! belief ([`belief_ops`]) each tally what the next one needs (sum, peak), and the motion leaves
+//! its normalisation to the correction's last pass, which also weighs the cells: an update
+//! writes the belief twice and reads it twice (the runs above the selective threshold, the
+//! most probable cell).
 
 pub mod belief_ops;
 pub mod correction;
@@ -40,9 +42,8 @@ use super::mcl::{BeamSubset, InitialBelief, LaserModelParams, PoseEstimate};
 use super::motion_model::{OdometryMotionModel, moved_enough};
 use crate::core::{Pose2, wrap_angle};
 use correction::PaddedField;
-use layout::{Layout, Span};
+use layout::Layout;
 use prediction::SubCell;
-use rayon::prelude::*;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct MarkovGridConfig {
@@ -97,13 +98,14 @@ impl Default for MarkovGridConfig {
 pub struct MarkovGrid {
     pub config: MarkovGridConfig,
     pub layout: Layout,
-    /// Probability per cell, θ-layer-major (k · ny + j) · nx + i; sums to 1.
+    /// Probability per cell, θ-layer-major (k · ny + j) · nx + i; sums to 1 after every update
+    /// (between a motion and its correction, to what the motion left).
     pub belief: Vec<f32>,
     /// Where the belief's mass sits within its cells ([`prediction`]).
     pub sub_cell: SubCell,
     /// Motion noise not yet blurred in: position (cells²) and heading (bins²) variance.
     pending_noise: [f64; 2],
-    /// What the pass that last wrote the belief found that the next one needs.
+    /// What the pass that last wrote the belief tallied.
     carried: Option<Carried>,
     scratch: Vec<f32>,
     field: Option<PaddedField>,
@@ -117,13 +119,23 @@ pub struct MarkovGrid {
     estimate_odom: Option<Pose2>,
 }
 
-/// What a pass over the belief found that the next needs, valid until the belief changes
-/// otherwise: its largest value (the selective threshold's scale) and, after a motion, the runs
-/// at or above the threshold that gives, per layer, with their number of cells.
-#[derive(Clone, Debug)]
+/// What the pass that last wrote the belief tallied, valid until the belief changes otherwise:
+/// its sum (1 up to rounding after a correction, less after a motion that dropped mass, which
+/// the next correction's normalisation takes back) and its largest value (the selective
+/// threshold's scale).
+#[derive(Clone, Copy, Debug)]
 struct Carried {
+    sum: f64,
     peak: f32,
-    runs: Option<(Vec<Vec<Span>>, usize)>,
+}
+
+impl Carried {
+    fn of(t: &belief_ops::Tally) -> Self {
+        Carried {
+            sum: t.sum(),
+            peak: t.peak(),
+        }
+    }
 }
 
 /// The motion noise variance (cells², bins²) worth a blur pass over the grid: smaller ones
@@ -204,11 +216,15 @@ impl MarkovGrid {
 
     /// Scales the belief to sum 1; false if it holds no mass.
     fn normalise(&mut self) -> bool {
-        self.normalise_sum(belief_ops::sum(&self.belief))
+        let total = match self.carried {
+            Some(c) => c.sum,
+            None => belief_ops::sum(&self.belief),
+        };
+        self.normalise_sum(total)
     }
 
-    /// Scales the belief, which sums to `total`, to sum 1 and keeps its largest value; false
-    /// if it holds no mass.
+    /// Scales the belief, which sums to `total`, to sum 1 and keeps its tally; false if it
+    /// holds no mass.
     fn normalise_sum(&mut self, total: f64) -> bool {
         self.carried = None;
         let Some(s) = normaliser(total) else {
@@ -216,43 +232,7 @@ impl MarkovGrid {
         };
         let mut t = belief_ops::Tally::default();
         belief_ops::scale(&mut self.belief, s, &mut t);
-        self.carried = Some(Carried {
-            peak: t.peak(),
-            runs: None,
-        });
-        true
-    }
-
-    /// [`MarkovGrid::normalise_sum`] for a belief tallied as `t`, finding on the way the runs
-    /// the next correction scores: the scaled peak is the peak scaled (rounding keeps the
-    /// order), so the threshold is known before the pass.
-    fn normalise_finding_runs(&mut self, t: &belief_ops::Tally) -> bool {
-        self.carried = None;
-        let Some(s) = normaliser(t.sum()) else {
-            return false;
-        };
-        let peak = t.peak() * s;
-        if self.config.selective_threshold <= 0.0 {
-            belief_ops::scale(&mut self.belief, s, &mut belief_ops::Tally::default());
-            self.carried = Some(Carried { peak, runs: None });
-            return true;
-        }
-        let threshold = self.threshold(peak);
-        let l = &self.layout;
-        // the cells outside free space hold 0, scaled or not
-        let runs: Vec<Vec<Span>> = self
-            .belief
-            .par_chunks_mut(l.layer())
-            .map(|b| {
-                l.runs(|cells, emit| {
-                    belief_ops::scale_and_find_runs(&mut b[cells], s, threshold, emit)
-                })
-            })
-            .collect();
-        self.carried = Some(Carried {
-            peak,
-            runs: Some(layout::counted(runs)),
-        });
+        self.carried = Some(Carried::of(&t));
         true
     }
 
@@ -261,8 +241,18 @@ impl MarkovGrid {
         (self.config.selective_threshold as f32 * peak).max(f32::MIN_POSITIVE)
     }
 
-    /// Prediction for the odometry motion `from` → `to`.
+    /// Prediction for the odometry motion `from` → `to`, the belief normalised again.
     pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
+        self.move_belief(from, to);
+        if !self.normalise() {
+            self.fill_uniform();
+        }
+    }
+
+    /// The prediction without its normalisation, which the correction that follows it folds
+    /// into its own last pass: the belief then sums to what the motion left of it (mass that
+    /// left free space is dropped), and [`Carried`] holds that sum and its peak.
+    fn move_belief(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
         let l = &self.layout;
         let mut tally =
@@ -290,7 +280,8 @@ impl MarkovGrid {
             tally = belief_ops::Tally::default();
             tally.add(&self.belief);
         }
-        if !self.normalise_finding_runs(&tally) {
+        self.carried = Some(Carried::of(&tally));
+        if normaliser(tally.sum()).is_none() {
             self.fill_uniform();
         }
     }
@@ -344,7 +335,7 @@ impl MapLocalizer for MarkovGrid {
             ) {
                 return false;
             }
-            self.apply_motion(&last, odom);
+            self.move_belief(&last, odom);
         }
         self.last_odom = Some(*odom);
         true

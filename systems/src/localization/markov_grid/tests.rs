@@ -1,5 +1,6 @@
 //! The Markov grid on the hospital map with scans ray-cast from a known trajectory.
 
+use super::layout::Span;
 use super::*;
 use crate::core::stream_rng;
 use crate::localization::mcl::BeamSubset;
@@ -291,9 +292,9 @@ fn converges_from_global_initialisation_and_tracks() {
 }
 
 /// What the fused passes carry from one to the next is what a pass of its own would find: the
-/// peak the selective threshold starts from, after the motion and after the weighing, the runs
-/// the correction scores, and the most probable cell the estimate starts from, over a global
-/// start and a drive.
+/// peak the selective threshold starts from and the sum the correction normalises by, after the
+/// motion and after the weighing, and the most probable cell the estimate starts from, over a
+/// global start and a drive; and the correction leaves the belief summing to 1.
 #[test]
 fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
     let map = hospital();
@@ -311,19 +312,22 @@ fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
             return;
         }
         if let Some(l) = last {
-            grid.apply_motion(&l, odom);
-            let carried = grid.carried.clone().unwrap();
+            grid.move_belief(&l, odom);
+            let carried = grid.carried.unwrap();
             assert_eq!(carried.peak, belief_ops::peak(&grid.belief));
-            let threshold = grid.threshold(carried.peak);
-            assert_eq!(carried.runs, Some(grid.active_runs(threshold)));
+            let sum = belief_ops::sum_plain(&grid.belief);
+            assert!((carried.sum - sum).abs() <= 1e-9 * sum, "{carried:?} {sum}");
         }
         last = Some(*odom);
         let pts = BeamSubset::from_scan(scan, &Pose2::IDENTITY, 60).returns();
         let best = grid.weigh(&map, &pts, scan.range_max);
         assert_eq!(best, belief_ops::argmax(&grid.belief).map(|b| b.0));
-        assert_eq!(
-            grid.carried.as_ref().map(|c| c.peak),
-            Some(belief_ops::peak(&grid.belief))
+        let carried = grid.carried.unwrap();
+        assert_eq!(carried.peak, belief_ops::peak(&grid.belief));
+        let sum = belief_ops::sum_plain(&grid.belief);
+        assert!(
+            (carried.sum - sum).abs() <= 1e-9 && (sum - 1.0).abs() < 1e-5,
+            "{carried:?} {sum}"
         );
         checked += 1;
     });

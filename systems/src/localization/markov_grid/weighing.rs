@@ -134,27 +134,32 @@ impl MarkovGrid {
         range_max: f32,
     ) -> Option<usize> {
         if points.is_empty() {
+            // nothing to weigh by: only the normalisation the motion left to the correction
+            if !self.normalise() {
+                self.fill_uniform();
+            }
             return None;
         }
         let lambda = self.config.likelihood_exponent as f32;
         // selective update only when it skips at least half of the cells
         let cells = self.layout.free_count() * self.layout.n_theta;
-        let carried = self.carried.take();
-        let peak = match &carried {
-            Some(c) => c.peak,
-            None => belief_ops::peak(&self.belief),
+        let before = match self.carried.take() {
+            Some(c) => c,
+            None => {
+                let mut t = belief_ops::Tally::default();
+                t.add(&self.belief);
+                Carried::of(&t)
+            }
         };
-        let threshold = self.threshold(peak);
+        let threshold = self.threshold(before.peak);
         let selective = (self.config.selective_threshold > 0.0)
-            .then(|| match carried.and_then(|c| c.runs) {
-                Some(runs) => runs,
-                None => self.active_runs(threshold),
-            })
+            .then(|| self.active_runs(threshold))
             .filter(|(_, n)| 2 * n < cells);
         let sampled = self.score(map, points, range_max, selective.as_ref().map(|a| &a.0[..]));
         let l = &self.layout;
-        // the belief's sum after the weighing, tallied by it where it passes over every cell
-        let total = match selective {
+        // the belief's sum after the weighing, and, for the selective update, the weight of the
+        // cells it did not score (the scored ones hold their weighed values in the scratch)
+        let (total, unscored) = match selective {
             None => {
                 let best = self
                     .belief
@@ -169,8 +174,10 @@ impl MarkovGrid {
                             *p *= (lambda * (l - best)).exp();
                         }
                     }
+                    (belief_ops::sum(&self.belief), None)
+                } else {
+                    (before.sum, None)
                 }
-                belief_ops::sum(&self.belief)
             }
             Some((runs, _)) => {
                 let layer = l.layer();
@@ -185,65 +192,73 @@ impl MarkovGrid {
                     .chain(sampled.iter().copied())
                     .fold(f32::NEG_INFINITY, f32::max);
                 if best.is_finite() {
-                    let floor = sampled
+                    let floor = (sampled
                         .iter()
                         .map(|&v| (lambda * (v - best)).exp() as f64)
                         .sum::<f64>()
-                        / sampled.len().max(1) as f64;
-                    // the cells not scored first, then the scored runs: those are the cells at
-                    // or above the threshold, which the first pass leaves as they are
-                    let mut all = belief_ops::Tally::default();
-                    belief_ops::scale_below(&mut self.belief, threshold, floor as f32, &mut all);
-                    // the sum: the tally's, with the scored cells' weighed values for their own
+                        / sampled.len().max(1) as f64) as f32;
+                    // the scored cells (those at or above the threshold) weighed into the
+                    // scratch; the sum: the others' scaled by the floor, plus these
                     let (mut unweighed, mut weighed) = (0.0f64, 0.0f64);
                     for (k, rs) in runs.iter().enumerate() {
                         for r in rs {
                             let a = k * layer + r.j as usize * l.nx + r.i0 as usize;
                             let cells = a..a + r.len as usize;
-                            for (p, &v) in self.belief[cells.clone()]
-                                .iter_mut()
-                                .zip(&self.scratch[cells])
+                            for (&p, v) in self.belief[cells.clone()]
+                                .iter()
+                                .zip(&mut self.scratch[cells])
                             {
-                                unweighed += *p as f64;
-                                *p *= (lambda * (v - best)).exp();
-                                weighed += *p as f64;
+                                unweighed += p as f64;
+                                *v = p * (lambda * (*v - best)).exp();
+                                weighed += *v as f64;
                             }
                         }
                     }
-                    all.sum() - unweighed + weighed
+                    let rest = (before.sum - unweighed).max(0.0) * floor as f64;
+                    (rest + weighed, Some((threshold, floor)))
                 } else {
-                    belief_ops::sum(&self.belief)
+                    (before.sum, None)
                 }
             }
         };
         // normalised and mixed with the uniform share in one pass over the free cells, which
-        // also finds the most probable cell
-        let s = match normaliser(total) {
-            Some(s) => s,
+        // also finds the most probable cell (and, in the selective update, weighs the cells)
+        let (s, unscored) = match normaliser(total) {
+            Some(s) => (s, unscored),
             None => {
                 self.fill_uniform();
-                1.0
+                (1.0, None)
             }
         };
         let mix = self.config.uniform_mix as f32;
         let l = &self.layout;
-        let u = mix / (l.free_count() * l.n_theta).max(1) as f32;
+        let (keep, u) = if mix > 0.0 {
+            (1.0 - mix, mix / (l.free_count() * l.n_theta).max(1) as f32)
+        } else {
+            (1.0, 0.0)
+        };
         let mut t = belief_ops::Tally::default();
-        if mix > 0.0 {
-            for k in 0..l.n_theta {
-                for sp in &l.spans {
-                    let a = k * l.layer() + sp.j as usize * l.nx + sp.i0 as usize;
-                    let cells = &mut self.belief[a..a + sp.len as usize];
-                    belief_ops::scale_and_mix(cells, s, 1.0 - mix, u, &mut t);
+        for k in 0..l.n_theta {
+            for sp in &l.spans {
+                let a = k * l.layer() + sp.j as usize * l.nx + sp.i0 as usize;
+                let cells = a..a + sp.len as usize;
+                match unscored {
+                    Some((threshold, floor)) => belief_ops::weigh_and_mix(
+                        &mut self.belief[cells.clone()],
+                        &self.scratch[cells],
+                        threshold,
+                        floor,
+                        [s, keep, u],
+                        &mut t,
+                    ),
+                    None => belief_ops::scale_and_mix(&mut self.belief[cells], s, keep, u, &mut t),
                 }
             }
-        } else {
-            belief_ops::scale(&mut self.belief, s, &mut t);
         }
         // the most probable cell is the first holding the largest value (for positive, finite
         // values, the first maximum in total_cmp's order)
         let peak = t.peak();
-        self.carried = Some(Carried { peak, runs: None });
+        self.carried = Some(Carried::of(&t));
         (peak > 0.0)
             .then(|| belief_ops::find(&self.belief, peak))
             .flatten()
