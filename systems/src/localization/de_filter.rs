@@ -92,8 +92,12 @@ impl Default for DeFilterConfig {
         DeFilterConfig {
             population: 2000,
             min_population: 100,
-            generations: 10,
-            tracking_generations: 3,
+            // with the scan proposal in the population from the first scan, more generations
+            // per update only narrowed it sooner, at times onto a look-alike place
+            generations: 5,
+            // once converged, the refinement of the best member and the gate do the tracking;
+            // more generations cost a fifth of the filter each and held no better
+            tracking_generations: 1,
             best_weight: 0.3,
             f: 0.5,
             f_growth: 1.2,

@@ -117,7 +117,9 @@ impl Default for MclConfig {
             recovery_alpha_fast: 0.1,
             recovery_ratio: 0.7,
             injection_candidates: 20_000,
-            challenge_every: 10,
+            // every 4 m of travel at 0.2 m per update: the challenge is most of a tracking
+            // filter's cost, and one every 2 m held no better
+            challenge_every: 20,
             challenge_ratio: 1.1,
             challenge_fraction: 0.1,
             init: InitialBelief::Global,
