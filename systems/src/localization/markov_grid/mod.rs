@@ -216,11 +216,15 @@ impl MarkovGrid {
 
     /// Scales the belief to sum 1; false if it holds no mass.
     fn normalise(&mut self) -> bool {
-        let total = match self.carried {
-            Some(c) => c.sum,
-            None => belief_ops::sum(&self.belief),
-        };
-        self.normalise_sum(total)
+        self.normalise_sum(belief_ops::sum(&self.belief))
+    }
+
+    /// [`MarkovGrid::normalise`] by the sum the last pass tallied, where there is one.
+    fn normalise_carried(&mut self) -> bool {
+        match self.carried {
+            Some(c) => self.normalise_sum(c.sum),
+            None => self.normalise(),
+        }
     }
 
     /// Scales the belief, which sums to `total`, to sum 1 and keeps its tally; false if it
@@ -244,7 +248,7 @@ impl MarkovGrid {
     /// Prediction for the odometry motion `from` → `to`, the belief normalised again.
     pub fn apply_motion(&mut self, from: &Pose2, to: &Pose2) {
         self.move_belief(from, to);
-        if !self.normalise() {
+        if !self.normalise_carried() {
             self.fill_uniform();
         }
     }

@@ -403,6 +403,33 @@ fn endpoints_beyond_the_map_or_not_finite_do_not_size_the_field() {
     assert_eq!(grid.belief, only_good.belief);
 }
 
+/// The motion leaves its normalisation to the correction: after a motion that drops mass off
+/// the free space, a correction with no endpoint to weigh by still leaves a distribution.
+#[test]
+fn a_correction_without_endpoints_normalises_what_the_motion_left() {
+    let map = crate::localization::props::room();
+    let config = MarkovGridConfig {
+        resolution: 0.5,
+        angular_bins: 12,
+        update_min_d: 0.0,
+        update_min_a: 0.0,
+        init: InitialBelief::Gaussian {
+            pose: Pose2::new(10.0, 4.0, 0.0),
+            sd: [0.5, 0.5, 0.1],
+        },
+        ..MarkovGridConfig::default()
+    };
+    let mut grid = MarkovGrid::new(config, &map);
+    assert!(grid.predict(&Pose2::IDENTITY));
+    // 1.5 m east, into the room's east wall at x = 12 m
+    assert!(grid.predict(&Pose2::new(1.5, 0.0, 0.0)));
+    let moved = belief_ops::sum_plain(&grid.belief);
+    assert!(moved < 0.9, "the motion kept {moved} of the mass");
+    assert!(grid.correct_points(&map, &[], 10.0));
+    let sum = belief_ops::sum_plain(&grid.belief);
+    assert!((sum - 1.0).abs() < 1e-5, "{sum}");
+}
+
 /// Properties under sensor faults: the belief stays a finite distribution and the estimate
 /// finite with a covariance, whatever the laser sends and however the odometry jumps.
 mod props {

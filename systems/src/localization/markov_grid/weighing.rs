@@ -135,7 +135,7 @@ impl MarkovGrid {
     ) -> Option<usize> {
         if points.is_empty() {
             // nothing to weigh by: only the normalisation the motion left to the correction
-            if !self.normalise() {
+            if !self.normalise_carried() {
                 self.fill_uniform();
             }
             return None;
