@@ -403,21 +403,33 @@ fn endpoints_beyond_the_map_or_not_finite_do_not_size_the_field() {
     assert_eq!(grid.belief, only_good.belief);
 }
 
+/// A coarse grid (0.5 m, 30°) in the 12 m × 8 m room that updates at every call, started
+/// around a pose.
+fn small() -> MarkovGridConfig {
+    MarkovGridConfig {
+        angular_bins: 12,
+        resolution: 0.5,
+        update_min_d: 0.0,
+        update_min_a: 0.0,
+        init: InitialBelief::Gaussian {
+            pose: Pose2::new(6.0, 4.0, 0.3),
+            sd: [0.5, 0.5, 0.2],
+        },
+        ..MarkovGridConfig::default()
+    }
+}
+
 /// The motion leaves its normalisation to the correction: after a motion that drops mass off
 /// the free space, a correction with no endpoint to weigh by still leaves a distribution.
 #[test]
 fn a_correction_without_endpoints_normalises_what_the_motion_left() {
     let map = crate::localization::props::room();
     let config = MarkovGridConfig {
-        resolution: 0.5,
-        angular_bins: 12,
-        update_min_d: 0.0,
-        update_min_a: 0.0,
         init: InitialBelief::Gaussian {
             pose: Pose2::new(10.0, 4.0, 0.0),
             sd: [0.5, 0.5, 0.1],
         },
-        ..MarkovGridConfig::default()
+        ..small()
     };
     let mut grid = MarkovGrid::new(config, &map);
     assert!(grid.predict(&Pose2::IDENTITY));
@@ -444,20 +456,6 @@ mod props {
         }
         let sum: f64 = b.iter().map(|&v| v as f64).sum();
         ((sum - 1.0).abs() > 1e-3).then(|| format!("belief sums to {sum}"))
-    }
-
-    fn small() -> MarkovGridConfig {
-        MarkovGridConfig {
-            angular_bins: 12,
-            resolution: 0.5,
-            update_min_d: 0.0,
-            update_min_a: 0.0,
-            init: InitialBelief::Gaussian {
-                pose: Pose2::new(6.0, 4.0, 0.3),
-                sd: [0.5, 0.5, 0.2],
-            },
-            ..MarkovGridConfig::default()
-        }
     }
 
     proptest! {
