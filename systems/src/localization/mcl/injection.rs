@@ -133,12 +133,16 @@ fn screened(
     let few: Vec<[f32; 2]> = points.iter().step_by(SCREEN_STRIDE).copied().collect();
     let score = scores(map, table, &few, cand);
     let mut order: Vec<usize> = (0..cand.len()).collect();
-    order.select_nth_unstable_by(keep - 1, |a, b| {
-        score[*b].total_cmp(&score[*a]).then(a.cmp(b))
-    });
+    order.select_nth_unstable_by(keep - 1, best_first(&score));
     let mut best = order[..keep].to_vec();
     best.sort_unstable();
     best.into_iter().map(|i| cand[i]).collect()
+}
+
+/// Candidate indices ordered by `score`, best first, ties by index: a total order, so a
+/// selection, a sort and a sort block by block agree.
+fn best_first(score: &[f64]) -> impl Fn(&usize, &usize) -> std::cmp::Ordering + Copy + '_ {
+    |a, b| score[*b].total_cmp(&score[*a]).then(a.cmp(b))
 }
 
 /// The likelihood-field score of each candidate for the scan endpoints `points`.
@@ -166,7 +170,7 @@ fn best_distinct(
     let score = scores(map, table, points, cand);
     // best first, ties by index: a total order, so sorting the best block after selecting it
     // gives the order of a full sort, block by block, until enough are kept
-    let better = |a: &usize, b: &usize| score[*b].total_cmp(&score[*a]).then(a.cmp(b));
+    let better = best_first(&score);
     let mut order: Vec<usize> = (0..cand.len()).collect();
     let mut per_bin: HashMap<(i64, i64, i64), usize> = HashMap::new();
     let mut kept = Vec::with_capacity(KEEP);
@@ -214,7 +218,7 @@ mod tests {
     ) -> Vec<[f64; 3]> {
         let score = scores(map, table, points, cand);
         let mut order: Vec<usize> = (0..cand.len()).collect();
-        order.sort_by(|&a, &b| score[b].total_cmp(&score[a]).then(a.cmp(&b)));
+        order.sort_by(best_first(&score));
         let mut per_bin: HashMap<(i64, i64, i64), usize> = HashMap::new();
         let mut kept = Vec::new();
         for i in order {
