@@ -90,7 +90,8 @@ pub struct MclConfig {
     /// resampling. A filter that converged to a look-alike place is pulled out of it this way:
     /// the weight averages cannot see a wrong place that fits the scans almost as well. A
     /// filter started globally draws from the proposal at every update until it settles (the
-    /// dual proposal of Mixture MCL, poses explaining the scan at least as well as its own).
+    /// dual proposal of Mixture MCL, poses explaining the scan better than its own): until its
+    /// dominant cluster is tight and holds most of the weight.
     pub challenge_every: u64,
     pub challenge_ratio: f64,
     pub challenge_fraction: f64,
@@ -160,8 +161,14 @@ const CONTENDER_POSES: usize = 32;
 /// keeps winning as the robot moves on is a different matter: the filter is at the wrong place.
 pub const CONTENDER_WINS: u32 = 4;
 
-/// The estimate's position spread (m) under which the filter counts as settled on a place.
+/// The estimate's position spread (m) under which the filter counts as settled on a place…
 pub const SETTLED_SPREAD_M: f64 = 0.5;
+
+/// …and the share of the weight its cluster must hold. A cluster can be tight long before the
+/// scans have told it from its look-alikes: a global filter's first tight cluster held a sixth
+/// of the weight, the rest sat on look-alike wards, and counting that as settled stopped the
+/// dual proposal after three to five updates, leaving the resampling to pick a ward by chance.
+pub const SETTLED_SHARE: f64 = 0.8;
 
 /// A challenger followed over updates: its poses move with the odometry (noise-free).
 #[derive(Clone, Debug)]
@@ -378,8 +385,11 @@ impl Mcl {
         (!pool.is_empty()).then_some(pool)
     }
 
-    /// The poses among `candidates` that explain the scan at least `ratio` times as well as
+    /// The poses among `candidates` that explain the scan more than `ratio` times as well as
     /// the filter's best explanation of it (the best of its heaviest particles), best first.
+    /// Strictly more: the field's scores saturate once every endpoint lies on an obstacle
+    /// cell, so a refined pose at a look-alike place often ties with the filter's best to the
+    /// bit, and a tie is no evidence against the filter's place.
     fn better_than_filter(
         &self,
         map: &LocalizationMap,
@@ -415,7 +425,7 @@ impl Mcl {
         let mut better: Vec<(f64, (f64, f64, f64))> = candidates
             .iter()
             .zip(&score[..m])
-            .filter(|&(_, &s)| s >= bar)
+            .filter(|&(_, &s)| s > bar)
             .map(|(p, &s)| (s, *p))
             .collect();
         better.sort_by(|a, b| b.0.total_cmp(&a.0));
@@ -423,11 +433,14 @@ impl Mcl {
     }
 
     /// Wins in a row a contender needs: one while the filter has not settled on a place (its
-    /// estimate's spread is over [`SETTLED_SPREAD_M`], as during global localization), so the
-    /// search is not slowed; [`CONTENDER_WINS`] once it has.
+    /// estimate's spread is over [`SETTLED_SPREAD_M`] or its cluster holds under
+    /// [`SETTLED_SHARE`] of the weight, as during global localization), so the search is not
+    /// slowed; [`CONTENDER_WINS`] once it has.
     fn wins_needed(&self) -> u32 {
         match self.estimate() {
-            Some(e) if e.position_spread() <= SETTLED_SPREAD_M => CONTENDER_WINS,
+            Some(e) if e.position_spread() <= SETTLED_SPREAD_M && e.weight >= SETTLED_SHARE => {
+                CONTENDER_WINS
+            }
             _ => 1,
         }
     }
@@ -491,9 +504,9 @@ impl Mcl {
         );
         if searching {
             // Mixture MCL's dual proposal [Thrun 2001, §4], at every update: poses drawn from
-            // the scan, weighed by a belief that is still about uniform over the places. Among
-            // look-alike places the true one gets particles again at every update, whatever
-            // the cloud's first draws held, until the scans tell the places apart.
+            // the scan, weighed by a belief that is still about uniform over the places. While
+            // the cloud's heaviest cluster sits at a look-alike, the true place gets particles
+            // again at every scan that fits it better, whatever the cloud's first draws held.
             let drawn = self.better_than_filter(map, &table, &points, &pool, 1.0);
             return (!drawn.is_empty()).then_some(drawn);
         }
@@ -514,7 +527,7 @@ impl Mcl {
     }
 
     /// Whether the filter is still searching the floor: started globally and not yet settled on
-    /// a place (its dominant cluster spreads over [`SETTLED_SPREAD_M`]). A filter started
+    /// a place (see [`Mcl::wins_needed`]). A filter started
     /// around a known pose is not: its belief is far from uniform over the places the scan
     /// proposal finds, and drawing from them pulled its estimate along a corridor.
     fn searching(&self) -> bool {

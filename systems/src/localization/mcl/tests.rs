@@ -178,6 +178,81 @@ fn challenges_pull_a_filter_out_of_a_wrong_place() {
     );
 }
 
+/// A global filter counts as settled only once its heaviest cluster is tight *and* holds most
+/// of the weight: three tight clusters at look-alike places, a third each, keep it searching
+/// (the dual proposal at every update, one win enough for a contender); nine tenths at one
+/// place settle it.
+#[test]
+fn a_tight_cluster_with_a_minority_of_the_weight_is_not_settled() {
+    let map = hospital();
+    let config = MclConfig {
+        max_particles: 3000,
+        ..tuned()
+    };
+    let mut mcl = Mcl::new(config, &map, stream_rng(4, "test", "mcl"));
+    let n = mcl.len();
+    let mut place = |share_first: f64| {
+        for i in 0..n {
+            let first = (i as f64) < share_first * n as f64;
+            let x = if first { 10.0 } else { [30.0, 50.0][i % 2] };
+            let jitter = (i % 7) as f64 * 0.01;
+            (mcl.xs[i], mcl.ys[i], mcl.ths[i]) = (x + jitter, 16.0 - jitter, 0.0);
+            mcl.w[i] = 1.0 / n as f64;
+        }
+        mcl.trig.clear();
+        mcl.estimate = OnceLock::new();
+        let e = mcl.estimate().unwrap();
+        assert!(e.position_spread() < 0.1, "{e:?}");
+        (e.weight, mcl.searching(), mcl.wins_needed())
+    };
+    let (share, searching, wins) = place(0.34);
+    assert!(
+        (0.3..0.4).contains(&share) && searching && wins == 1,
+        "{share}"
+    );
+    let (share, searching, wins) = place(0.9);
+    assert!(
+        share >= 0.9 && !searching && wins == CONTENDER_WINS,
+        "{share}"
+    );
+}
+
+/// A pose that only ties with the filter's best explanation of the scan is not better than it:
+/// the likelihood field's scores saturate, so a look-alike place often ties to the bit. The
+/// filter's own heaviest particles, offered back to it, are never drawn; the true pose, 0.3 m
+/// beside a confident cloud, is.
+#[test]
+fn poses_that_tie_with_the_filter_are_not_better_than_it() {
+    let map = hospital();
+    let truth = Pose2::new(CORRIDOR[0][0], CORRIDOR[0][1], 0.0);
+    let config = MclConfig {
+        init: InitialBelief::Gaussian {
+            pose: Pose2::new(truth.x, truth.y + 0.3, 0.0),
+            sd: [0.02, 0.02, 0.01],
+        },
+        ..tuned()
+    };
+    let mut mcl = Mcl::new(config, &map, stream_rng(5, "test", "mcl"));
+    let scan = scan_at(&map, &truth, &mut stream_rng(5, "test", "scan"));
+    let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60);
+    mcl.weigh_particles(&map, &beams);
+    let mut top: Vec<usize> = (0..mcl.len()).collect();
+    top.sort_by(|&a, &b| mcl.w[b].total_cmp(&mcl.w[a]).then(a.cmp(&b)));
+    let own: Vec<(f64, f64, f64)> = top[..CHALLENGE_TOP]
+        .iter()
+        .map(|&i| (mcl.xs[i], mcl.ys[i], mcl.ths[i]))
+        .collect();
+    let table = mcl.field_table(&map, beams.range_max);
+    let points = beams.returns();
+    assert!(
+        mcl.better_than_filter(&map, &table, &points, &own, 1.0)
+            .is_empty()
+    );
+    let at_truth = [(truth.x, truth.y, truth.theta)];
+    let better = mcl.better_than_filter(&map, &table, &points, &at_truth, 1.0);
+    assert_eq!(better.len(), 1);
+}
+
 /// Weighing a grid of poses around the truth: the best is within a cell of it (no bias
 /// towards the walls the beams end on).
 #[test]
