@@ -95,9 +95,10 @@ impl Default for DeFilterConfig {
             // with the scan proposal in the population from the first scan, more generations
             // per update only narrowed it sooner, at times onto a look-alike place
             generations: 5,
-            // once converged, the refinement of the best member and the gate do the tracking;
-            // more generations cost a fifth of the filter each and held no better
-            tracking_generations: 1,
+            // once converged, the refinement of the best member and the gate do most of the
+            // tracking; with one generation an estimate could slide along a corridor and stay
+            // behind the robot for a second
+            tracking_generations: 2,
             best_weight: 0.3,
             f: 0.5,
             f_growth: 1.2,
