@@ -313,7 +313,7 @@ pub fn run_markov_grid_bench(g: &GridBenchOptions) -> anyhow::Result<()> {
                     beams_used = beams_used.max(b.len());
                 }
             }
-            let cells = g.layout.free_count() * g.layout.n_theta;
+            let cells = g.whole.free_count() * g.whole.n_theta;
             (times, cells, beams_used, g.config.clone())
         })?;
         let s = stats(times);

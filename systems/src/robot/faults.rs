@@ -274,7 +274,7 @@ fn fault_of(world: &World, robot: Entity, unusable: bool) -> Option<String> {
             return Some(format!("{}: {why}", l.name));
         }
         if let Some(g) = l.filter.downcast_ref::<MarkovGrid>() {
-            let sum: f64 = g.belief.iter().map(|&v| v as f64).sum();
+            let sum = g.total_mass();
             if g.belief.iter().any(|v| !(v.is_finite() && *v >= 0.0)) || (sum - 1.0).abs() > 1e-3 {
                 return Some(format!("{}: belief sums to {sum}", l.name));
             }

@@ -124,6 +124,97 @@ impl Layout {
     }
 }
 
+/// A rectangle of the lattice: columns `i0 .. i0 + nx`, rows `j0 .. j0 + ny`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Rect {
+    pub i0: usize,
+    pub j0: usize,
+    pub nx: usize,
+    pub ny: usize,
+}
+
+impl Rect {
+    pub fn area(&self) -> usize {
+        self.nx * self.ny
+    }
+
+    /// Whether `other` lies wholly inside.
+    pub fn contains(&self, other: &Rect) -> bool {
+        other.i0 >= self.i0
+            && other.j0 >= self.j0
+            && other.i0 + other.nx <= self.i0 + self.nx
+            && other.j0 + other.ny <= self.j0 + self.ny
+    }
+
+    /// Grown by `by` cells on every side, clipped to `bounds`.
+    pub fn grown(&self, by: usize, bounds: &Rect) -> Rect {
+        let (i0, j0) = (
+            self.i0.saturating_sub(by).max(bounds.i0),
+            self.j0.saturating_sub(by).max(bounds.j0),
+        );
+        let i1 = (self.i0 + self.nx + by).min(bounds.i0 + bounds.nx);
+        let j1 = (self.j0 + self.ny + by).min(bounds.j0 + bounds.ny);
+        Rect {
+            i0,
+            j0,
+            nx: i1.saturating_sub(i0),
+            ny: j1.saturating_sub(j0),
+        }
+    }
+}
+
+impl Layout {
+    /// The whole lattice as a rectangle.
+    pub fn rect(&self) -> Rect {
+        Rect {
+            i0: 0,
+            j0: 0,
+            nx: self.nx,
+            ny: self.ny,
+        }
+    }
+
+    /// The lattice of the cells of `r` (which must lie within this one) on their own: cell
+    /// (i, j) of the result is cell (r.i0 + i, r.j0 + j) of this one, at the same place and
+    /// equally free.
+    pub fn crop(&self, r: &Rect) -> Layout {
+        let (nx, ny) = (r.nx.max(1), r.ny.max(1));
+        let mut free = Vec::with_capacity(nx * ny);
+        for j in r.j0..r.j0 + ny {
+            free.extend_from_slice(&self.free[j * self.nx + r.i0..][..nx]);
+        }
+        let mut spans = Vec::new();
+        for s in &self.spans {
+            let j = s.j as usize;
+            let (a, b) = (
+                (s.i0 as usize).max(r.i0),
+                ((s.i0 + s.len) as usize).min(r.i0 + nx),
+            );
+            if j >= r.j0 && j < r.j0 + ny && a < b {
+                spans.push(Span {
+                    j: (j - r.j0) as u32,
+                    i0: (a - r.i0) as u32,
+                    len: (b - a) as u32,
+                });
+            }
+        }
+        Layout {
+            resolution: self.resolution,
+            nx,
+            ny,
+            n_theta: self.n_theta,
+            origin: [
+                self.origin[0] + r.i0 as f64 * self.resolution,
+                self.origin[1] + r.j0 as f64 * self.resolution,
+            ],
+            fine_col: self.fine_col[r.i0..r.i0 + nx].to_vec(),
+            fine_row: self.fine_row[r.j0..r.j0 + ny].to_vec(),
+            free,
+            spans,
+        }
+    }
+}
+
 impl Layout {
     /// The runs of one θ layer: `find(cells, emit)` is called for each span of free cells (its
     /// place in the layer) and reports runs within it as `emit(start, len)`.
@@ -150,4 +241,84 @@ impl Layout {
 pub fn counted(runs: Vec<Vec<Span>>) -> (Vec<Vec<Span>>, usize) {
     let n = runs.iter().flatten().map(|r| r.len as usize).sum();
     (runs, n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::localization::test_drive::hospital;
+
+    /// A cropped lattice is the same cells: same places, same free cells, the same runs clipped.
+    #[test]
+    fn a_crop_is_the_same_cells_in_their_own_lattice() {
+        let map = hospital();
+        let whole = Layout::new(&map.grid, 0.25, 36);
+        let r = Rect {
+            i0: 37,
+            j0: 20,
+            nx: 41,
+            ny: 23,
+        };
+        let c = whole.crop(&r);
+        assert_eq!((c.nx, c.ny, c.n_theta), (41, 23, 36));
+        let mut free = 0;
+        for j in 0..c.ny {
+            for i in 0..c.nx {
+                let (x, y) = c.centre(i, j);
+                let (wx, wy) = whole.centre(i + r.i0, j + r.j0);
+                assert!((x - wx).abs() < 1e-9 && (y - wy).abs() < 1e-9);
+                let f = whole.free[(j + r.j0) * whole.nx + i + r.i0];
+                assert_eq!(c.free[j * c.nx + i], f);
+                free += usize::from(f);
+            }
+        }
+        assert!(free > 0 && free < r.area(), "{free}");
+        assert_eq!(c.free_count(), free);
+        // the runs cover exactly the free cells, in row then column order
+        let mut covered = vec![false; c.layer()];
+        for s in &c.spans {
+            for i in s.i0..s.i0 + s.len {
+                covered[s.j as usize * c.nx + i as usize] = true;
+            }
+        }
+        assert_eq!(covered, c.free);
+        assert!(
+            c.spans
+                .windows(2)
+                .all(|w| (w[0].j, w[0].i0 + w[0].len) < (w[1].j, w[1].i0))
+        );
+        // the whole lattice cropped to itself is itself
+        let same = whole.crop(&whole.rect());
+        assert_eq!(
+            (same.spans, same.free),
+            (whole.spans.clone(), whole.free.clone())
+        );
+    }
+
+    #[test]
+    fn rects_grow_within_their_bounds() {
+        let bounds = Rect {
+            i0: 0,
+            j0: 0,
+            nx: 100,
+            ny: 50,
+        };
+        let r = Rect {
+            i0: 3,
+            j0: 40,
+            nx: 5,
+            ny: 5,
+        };
+        let g = r.grown(10, &bounds);
+        assert_eq!(
+            g,
+            Rect {
+                i0: 0,
+                j0: 30,
+                nx: 18,
+                ny: 20
+            }
+        );
+        assert!(g.contains(&r) && bounds.contains(&g) && !r.contains(&g));
+    }
 }

@@ -21,6 +21,9 @@
 //!   motion model's noise for that motion, at least a fifth of a cell and of a heading bin); the
 //!   belief itself stays a histogram.
 //!
+//! Once the belief has gathered, it is held cell by cell only on a window of the lattice around
+//! the cells the selective update scores, the rest as one background value ([`window`]).
+//!
 //! Like MCL, it updates only after a minimum travel or turn of the odometry. Layers (θ) are
 //! scored in parallel; each layer's result depends on that layer only. The passes over the whole
 //! belief ([`belief_ops`]) each tally what the next one needs (sum, peak), and the motion leaves
@@ -35,6 +38,7 @@ pub mod layout;
 pub mod prediction;
 pub mod refine;
 mod weighing;
+pub mod window;
 
 use super::map::LocalizationMap;
 use super::map_localizer::MapLocalizer;
@@ -97,10 +101,20 @@ impl Default for MarkovGridConfig {
 #[derive(Clone, Debug)]
 pub struct MarkovGrid {
     pub config: MarkovGridConfig,
+    /// The lattice of the map's free space.
+    pub whole: Layout,
+    /// The lattice the belief is held on: the whole one, or a window of it ([`window`]).
     pub layout: Layout,
-    /// Probability per cell, θ-layer-major (k · ny + j) · nx + i; sums to 1 after every update
-    /// (between a motion and its correction, to what the motion left).
+    /// The window's first column and row in the whole lattice.
+    at: [usize; 2],
+    /// Probability per cell of `layout`, θ-layer-major (k · ny + j) · nx + i; with the mass
+    /// outside the window, sums to 1 after every update (between a motion and its correction,
+    /// to what the motion left).
     pub belief: Vec<f32>,
+    /// The mass outside the window, spread evenly over its free cells (0 without a window).
+    outside: f64,
+    /// Never hold the belief on a window (the plain filter the window is tested against).
+    hold_whole: bool,
     /// Where the belief's mass sits within its cells ([`prediction`]).
     pub sub_cell: SubCell,
     /// Motion noise not yet blurred in: position (cells²) and heading (bins²) variance.
@@ -120,7 +134,7 @@ pub struct MarkovGrid {
 }
 
 /// What the pass that last wrote the belief tallied, valid until the belief changes otherwise:
-/// its sum (1 up to rounding after a correction, less after a motion that dropped mass, which
+/// its sum with the mass outside the window (1 up to rounding after a correction, less after a motion that dropped mass, which
 /// the next correction's normalisation takes back) and its largest value (the selective
 /// threshold's scale).
 #[derive(Clone, Copy, Debug)]
@@ -129,10 +143,11 @@ struct Carried {
     peak: f32,
 }
 
-impl Carried {
-    fn of(t: &belief_ops::Tally) -> Self {
+impl MarkovGrid {
+    /// What a pass that wrote the window and tallied `t` leaves.
+    fn carry(&self, t: &belief_ops::Tally) -> Carried {
         Carried {
-            sum: t.sum(),
+            sum: t.sum() + self.outside,
             peak: t.peak(),
         }
     }
@@ -143,6 +158,12 @@ impl Carried {
 /// (about every 25th at 0.25 m per update and α = 0.01).
 const BLUR_VARIANCE: f64 = 0.25;
 
+/// Cells of the belief's window ([`window`]) beyond the cells above the selective threshold, on
+/// every side (2.5 m at the default 0.25 m): the window moves when they come within half of it
+/// of its edge, and a motion or a blur reaching further than that half is done on the whole
+/// lattice.
+pub const WINDOW_MARGIN: usize = 10;
+
 /// The factor that scales a belief summing to `total` to sum 1, if it holds mass.
 fn normaliser(total: f64) -> Option<f32> {
     (total > 0.0 && total.is_finite()).then(|| (1.0 / total) as f32)
@@ -152,6 +173,10 @@ impl MarkovGrid {
     pub fn new(config: MarkovGridConfig, map: &LocalizationMap) -> Self {
         let layout = Layout::new(&map.grid, config.resolution, config.angular_bins);
         let mut g = MarkovGrid {
+            whole: layout.clone(),
+            at: [0, 0],
+            outside: 0.0,
+            hold_whole: false,
             belief: vec![0.0; layout.len()],
             sub_cell: SubCell::centred(&layout),
             pending_noise: [0.0; 2],
@@ -201,6 +226,13 @@ impl MarkovGrid {
 
     fn fill_uniform(&mut self) {
         self.carried = None;
+        if self.is_windowed() {
+            self.layout = self.whole.clone();
+            self.at = [0, 0];
+            self.belief = vec![0.0; self.layout.len()];
+            self.scratch = vec![0.0; self.layout.len()];
+        }
+        self.outside = 0.0;
         let l = &self.layout;
         let n = (l.free_count() * l.n_theta).max(1) as f32;
         self.belief.iter_mut().for_each(|v| *v = 0.0);
@@ -216,7 +248,7 @@ impl MarkovGrid {
 
     /// Scales the belief to sum 1; false if it holds no mass.
     fn normalise(&mut self) -> bool {
-        self.normalise_sum(belief_ops::sum(&self.belief))
+        self.normalise_sum(self.total_mass())
     }
 
     /// [`MarkovGrid::normalise`] by the sum the last pass tallied, where there is one.
@@ -236,7 +268,8 @@ impl MarkovGrid {
         };
         let mut t = belief_ops::Tally::default();
         belief_ops::scale(&mut self.belief, s, &mut t);
-        self.carried = Some(Carried::of(&t));
+        self.outside *= s as f64;
+        self.carried = Some(self.carry(&t));
         true
     }
 
@@ -258,17 +291,45 @@ impl MarkovGrid {
     /// left free space is dropped), and [`Carried`] holds that sum and its peak.
     fn move_belief(&mut self, from: &Pose2, to: &Pose2) {
         let d = self.config.motion.delta(from, to);
+        // a window holds a motion of up to half its margin (its cells above the threshold lie
+        // at least that far from its edge)
+        if (d.trans / self.layout.resolution).ceil() + 1.0 > (WINDOW_MARGIN / 2) as f64 {
+            self.unwindow();
+        }
+        let (windowed, value) = (self.is_windowed(), self.background());
+        let edge = windowed.then_some(prediction::Edge {
+            whole: &self.whole,
+            at: self.at,
+            value,
+        });
         let l = &self.layout;
-        let mut tally =
-            prediction::shift(l, &d, &mut self.sub_cell, &self.belief, &mut self.scratch);
+        let mut tally = prediction::shift(
+            l,
+            &d,
+            &mut self.sub_cell,
+            &self.belief,
+            &mut self.scratch,
+            edge,
+        );
         std::mem::swap(&mut self.belief, &mut self.scratch);
         // a blur as wide as the grid already spreads the mass over all of it: capped there, so
         // a jump of the odometry does not ask for a kernel as long as the jump
         let cap = |n: usize| (n * n) as f64;
         let xy = (d.sd_trans.hypot(d.trans * d.sd_rot1) / l.resolution).powi(2);
         let th = (d.sd_rot1.hypot(d.sd_rot2) / l.theta_step()).powi(2);
-        self.pending_noise[0] = (self.pending_noise[0] + xy).min(cap(l.nx.max(l.ny)));
+        self.pending_noise[0] =
+            (self.pending_noise[0] + xy).min(cap(self.whole.nx.max(self.whole.ny)));
         self.pending_noise[1] = (self.pending_noise[1] + th).min(cap(l.n_theta));
+        // a window is blurred as if nothing lay outside it (its edge cells lose the little mass
+        // the blur moves outward), unless the kernel reaches past half its margin
+        let reach = |var: f64| prediction::kernel_of_variance(var).len() / 2;
+        if self.pending_noise[0] >= BLUR_VARIANCE
+            && reach(self.pending_noise[0]) > WINDOW_MARGIN / 2
+        {
+            self.unwindow();
+            tally = belief_ops::Tally::default();
+            tally.add(&self.belief);
+        }
         if self.pending_noise[0] >= BLUR_VARIANCE {
             let k = prediction::kernel_of_variance(self.pending_noise[0]);
             prediction::blur_xy(&self.layout, &k, &mut self.belief);
@@ -284,8 +345,8 @@ impl MarkovGrid {
             tally = belief_ops::Tally::default();
             tally.add(&self.belief);
         }
-        self.carried = Some(Carried::of(&tally));
-        if normaliser(tally.sum()).is_none() {
+        self.carried = Some(self.carry(&tally));
+        if normaliser(tally.sum() + self.outside).is_none() {
             self.fill_uniform();
         }
     }

@@ -56,19 +56,30 @@ impl SubCell {
     }
 }
 
+/// What lies beyond the edge of a grid that is a window of a larger lattice ([`super::window`]):
+/// the window's place in `whole`, and the value of every free cell of `whole` outside it.
+#[derive(Clone, Copy, Debug)]
+pub struct Edge<'a> {
+    pub whole: &'a Layout,
+    pub at: [usize; 2],
+    pub value: f32,
+}
+
 /// Moves `src` (all θ layers, at the offsets `sub`) by `d` into `dst`, and `sub` to the offsets
 /// of the moved mass. Every free cell of `dst` is written: the mass from its source cell if that
 /// lies in the grid, 0 otherwise (mass that leaves the grid or lands on an occupied or unknown
-/// cell is dropped). Neither `src` nor `dst` holds anything outside free space. Returns `dst`'s
-/// tally (sum and peak).
+/// cell is dropped), or, for a window with its `edge`, the edge's value where the source cell
+/// lies outside the window on a free cell of the whole lattice. Neither `src` nor `dst` holds
+/// anything outside free space. Returns `dst`'s tally (sum and peak).
 pub fn shift(
     layout: &Layout,
     d: &OdometryDelta,
     sub: &mut SubCell,
     src: &[f32],
     dst: &mut [f32],
+    edge: Option<Edge>,
 ) -> Tally {
-    let (moves, turn) = layer_moves(layout, d, sub);
+    let (moves, turn) = layer_moves(layout, edge.map_or(layout, |e| e.whole), d, sub);
     let (nx, ny) = (layout.nx as isize, layout.ny as isize);
     let layer = layout.layer();
     let mut tally = Tally::default();
@@ -114,11 +125,53 @@ pub fn shift(
             tally.add(&row[lo..hi]);
         }
     }
+    if let Some(e) = edge {
+        inflow(layout, &e, &moves, &rows, dst, &mut tally);
+    }
     for m in &moves {
         sub.xy[m.to] = m.rest;
     }
     sub.theta = turn;
     tally
+}
+
+/// The cells of a window whose source under `moves` lies outside it, on a free cell of the
+/// whole lattice: they take the edge's value (tallied).
+fn inflow(
+    layout: &Layout,
+    e: &Edge,
+    moves: &[LayerMove],
+    rows: &[&[Span]],
+    dst: &mut [f32],
+    tally: &mut Tally,
+) {
+    let (nx, ny) = (layout.nx as isize, layout.ny as isize);
+    let (wx, wy) = (e.whole.nx as isize, e.whole.ny as isize);
+    let [ax, ay] = e.at.map(|a| a as isize);
+    for m in moves {
+        let into = &mut dst[m.to * layout.layer()..][..layout.layer()];
+        for (tj, spans) in rows.iter().enumerate() {
+            let j = tj as isize - m.iy;
+            let row_outside = j < 0 || j >= ny;
+            let wj = j + ay;
+            if wj < 0 || wj >= wy {
+                continue;
+            }
+            for s in *spans {
+                for i in s.i0 as isize..(s.i0 + s.len) as isize {
+                    let si = i - m.ix;
+                    if !row_outside && si >= 0 && si < nx {
+                        continue;
+                    }
+                    let wi = si + ax;
+                    if wi >= 0 && wi < wx && e.whole.free[(wj * wx + wi) as usize] {
+                        into[tj * layout.nx + i as usize] = e.value;
+                        tally.add(&[e.value]);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// The layout's spans row by row (they are listed by row, then column).
@@ -144,13 +197,19 @@ struct LayerMove {
 
 /// Every layer's move under the motion `d`, and the heading offset (bins) left over for all
 /// layers: each layer moves by its offset plus the motion as seen from its heading, rounded to
-/// whole cells, and all turn by the same whole bins. A move past the grid's extent drops all
-/// the mass, as any longer one: clamped there so the cell arithmetic stays within integers.
-fn layer_moves(layout: &Layout, d: &OdometryDelta, sub: &SubCell) -> (Vec<LayerMove>, f64) {
+/// whole cells, and all turn by the same whole bins. A move past the extent of the lattice
+/// `extent` (the grid's, or the whole one a window is part of) drops all the mass, as any longer
+/// one: clamped there so the cell arithmetic stays within integers.
+fn layer_moves(
+    layout: &Layout,
+    extent: &Layout,
+    d: &OdometryDelta,
+    sub: &SubCell,
+) -> (Vec<LayerMove>, f64) {
     let nt = layout.n_theta as isize;
     let turn = sub.theta + (d.rot1 + d.rot2) / layout.theta_step();
     let dk = turn.round();
-    let beyond = (layout.nx + layout.ny + 2) as f64;
+    let beyond = (extent.nx + extent.ny + 2) as f64;
     let moves = sub
         .xy
         .iter()
@@ -272,7 +331,7 @@ mod tests {
     /// place, then clear the cells that are not free.
     fn shift_plain(l: &Layout, d: &OdometryDelta, sub: &mut SubCell, src: &[f32], dst: &mut [f32]) {
         dst.fill(0.0);
-        let (moves, turn) = layer_moves(l, d, sub);
+        let (moves, turn) = layer_moves(l, l, d, sub);
         let (nx, ny, layer) = (l.nx as isize, l.ny as isize, l.layer());
         for (k, m) in moves.iter().enumerate() {
             for s in &l.spans {
@@ -423,7 +482,7 @@ mod tests {
                 .collect();
             let mut plain = vec![0.0f32; l.len()];
             let (mut sub_fast, mut sub_plain) = (sub.clone(), sub.clone());
-            let total = shift(&l, &d, &mut sub_fast, &src, &mut fast).sum();
+            let total = shift(&l, &d, &mut sub_fast, &src, &mut fast, None).sum();
             shift_plain(&l, &d, &mut sub_plain, &src, &mut plain);
             assert!(
                 fast.iter()
@@ -438,6 +497,90 @@ mod tests {
             if src.iter().all(|&v| v == 0.0) {
                 break;
             }
+        }
+    }
+
+    /// A window of the lattice shifted with its edge writes what the whole lattice shifted
+    /// writes on the window's cells, where every free cell outside the window holds the edge's
+    /// value.
+    #[test]
+    fn a_window_shifts_as_the_whole_lattice_with_its_background() {
+        use super::super::layout::Rect;
+        let map = hospital();
+        let whole = Layout::new(&map.grid, 0.25, 36);
+        let r = Rect {
+            i0: 30,
+            j0: 12,
+            nx: 40,
+            ny: 30,
+        };
+        let win = whole.crop(&r);
+        let background = 3e-9f32;
+        let mut rng = stream_rng(5, "test", "window-shift");
+        let inside =
+            |i: usize, j: usize| i >= r.i0 && i < r.i0 + r.nx && j >= r.j0 && j < r.j0 + r.ny;
+        let mut src_whole = vec![0.0f32; whole.len()];
+        for (c, v) in src_whole.iter_mut().enumerate() {
+            let cell = c % whole.layer();
+            let (i, j) = (cell % whole.nx, cell / whole.nx);
+            if whole.free[cell] {
+                *v = if inside(i, j) {
+                    rng.random_range(0.0..1.0)
+                } else {
+                    background
+                };
+            }
+        }
+        let window_of = |v: &[f32]| -> Vec<f32> {
+            let mut w = Vec::with_capacity(win.len());
+            for layer in v.chunks(whole.layer()) {
+                for j in r.j0..r.j0 + r.ny {
+                    w.extend_from_slice(&layer[j * whole.nx + r.i0..][..r.nx]);
+                }
+            }
+            w
+        };
+        let model = OdometryMotionModel::default();
+        for (x, y, th) in [
+            (0.3, 0.1, 0.1),
+            (-0.9, 1.4, -0.7),
+            (2.5, -3.0, 2.0),
+            (40.0, 0.0, 0.0),
+        ] {
+            let d = model.delta(&Pose2::IDENTITY, &Pose2::new(x, y, th));
+            let mut sub_whole = SubCell::centred(&whole);
+            let mut out_whole = vec![0.0f32; whole.len()];
+            shift(&whole, &d, &mut sub_whole, &src_whole, &mut out_whole, None);
+            let mut sub_win = SubCell::centred(&win);
+            let mut out_win = vec![7.0f32; win.len()];
+            let edge = Edge {
+                whole: &whole,
+                at: [r.i0, r.j0],
+                value: background,
+            };
+            let tally = shift(
+                &win,
+                &d,
+                &mut sub_win,
+                &window_of(&src_whole),
+                &mut out_win,
+                Some(edge),
+            );
+            // the window's free cells as the whole lattice's; its other cells untouched
+            let want = window_of(&out_whole);
+            for (c, (a, b)) in out_win.iter().zip(&want).enumerate() {
+                if win.free[c % win.layer()] {
+                    assert_eq!(a.to_bits(), b.to_bits(), "cell {c} after {x} {y} {th}");
+                }
+            }
+            assert_eq!(sub_win, sub_whole);
+            let free_sum: f64 = out_win
+                .iter()
+                .enumerate()
+                .filter(|(c, _)| win.free[c % win.layer()])
+                .map(|(_, &v)| v as f64)
+                .sum();
+            assert!((tally.sum() - free_sum).abs() <= 1e-9 * free_sum.max(1.0));
         }
     }
 }

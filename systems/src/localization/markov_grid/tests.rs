@@ -306,7 +306,7 @@ fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
         &map,
     );
     let mut last: Option<Pose2> = None;
-    let mut checked = 0;
+    let (mut checked, mut windowed) = (0, 0);
     drive(&map, &CORRIDOR, 0.0, 5, |_, odom, scan| {
         if last.is_some_and(|l| !moved_enough(&l, odom, 0.25, 10f64.to_radians())) {
             return;
@@ -315,7 +315,7 @@ fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
             grid.move_belief(&l, odom);
             let carried = grid.carried.unwrap();
             assert_eq!(carried.peak, belief_ops::peak(&grid.belief));
-            let sum = belief_ops::sum_plain(&grid.belief);
+            let sum = belief_ops::sum_plain(&grid.belief) + grid.outside;
             assert!((carried.sum - sum).abs() <= 1e-9 * sum, "{carried:?} {sum}");
         }
         last = Some(*odom);
@@ -324,14 +324,20 @@ fn the_carried_peak_and_most_probable_cell_are_the_belief_s() {
         assert_eq!(best, belief_ops::argmax(&grid.belief).map(|b| b.0));
         let carried = grid.carried.unwrap();
         assert_eq!(carried.peak, belief_ops::peak(&grid.belief));
-        let sum = belief_ops::sum_plain(&grid.belief);
+        let sum = belief_ops::sum_plain(&grid.belief) + grid.outside;
         assert!(
             (carried.sum - sum).abs() <= 1e-9 && (sum - 1.0).abs() < 1e-5,
             "{carried:?} {sum}"
         );
         checked += 1;
+        windowed += usize::from(grid.is_windowed());
     });
     assert!(checked > 50, "{checked} updates");
+    // the belief gathered, and was then held on a window
+    assert!(
+        windowed > checked / 2,
+        "{windowed} of {checked} updates on a window"
+    );
 }
 
 /// The most probable cell is the one `max_by` with `total_cmp`, ties to the first, picks: on
@@ -450,11 +456,17 @@ mod props {
     use crate::localization::props::{estimate_fault, faulted_drive, odometry_step, room};
     use proptest::prelude::*;
 
-    fn belief_fault(b: &[f32]) -> Option<String> {
-        if let Some(bad) = b.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+    fn belief_fault(g: &MarkovGrid) -> Option<String> {
+        let background = g.background();
+        if let Some(bad) = g
+            .belief
+            .iter()
+            .chain([&background])
+            .find(|v| !(v.is_finite() && **v >= 0.0))
+        {
             return Some(format!("cell {bad}"));
         }
-        let sum: f64 = b.iter().map(|&v| v as f64).sum();
+        let sum = g.total_mass();
         ((sum - 1.0).abs() > 1e-3).then(|| format!("belief sums to {sum}"))
     }
 
@@ -474,7 +486,7 @@ mod props {
                 MarkovGridConfig { selective_threshold: selective, ..small() }, &map);
             let points: Vec<[f32; 2]> = points.iter().map(|p| [p.0, p.1]).collect();
             prop_assert!(grid.correct_points(&map, &points, range_max));
-            prop_assert_eq!(belief_fault(&grid.belief), None);
+            prop_assert_eq!(belief_fault(&grid), None);
             let e = grid.estimate();
             prop_assert!(e.is_some());
             prop_assert_eq!(e.and_then(|e| estimate_fault(&e)), None);
@@ -492,7 +504,7 @@ mod props {
             for (odom, beams) in faulted_drive(&map, &steps) {
                 grid.predict(&odom);
                 grid.correct(&map, &beams);
-                prop_assert_eq!(belief_fault(&grid.belief), None);
+                prop_assert_eq!(belief_fault(&grid), None);
                 let e = grid.estimate();
                 prop_assert!(e.is_some());
                 prop_assert_eq!(e.and_then(|e| estimate_fault(&e)), None);

@@ -5,7 +5,7 @@
 
 use super::correction::reachable;
 use super::layout::{Layout, Span, counted};
-use super::{Carried, MarkovGrid, belief_ops, correction, normaliser};
+use super::{MarkovGrid, belief_ops, correction, normaliser};
 use crate::localization::map::LocalizationMap;
 use correction::PaddedField;
 use rayon::prelude::*;
@@ -14,7 +14,8 @@ use rayon::prelude::*;
 /// 0.97 million free cells × bins).
 const SAMPLE_STRIDE: usize = 487;
 
-/// The selective update's sample: every `SAMPLE_STRIDE`-th cell in (layer, span) order.
+/// The selective update's sample: every `SAMPLE_STRIDE`-th cell in (layer, span) order, of the
+/// whole lattice.
 fn sample_cells(l: &Layout) -> Vec<Vec<(u32, u32)>> {
     let mut c = 0usize;
     (0..l.n_theta)
@@ -64,14 +65,14 @@ impl MarkovGrid {
             })
             .collect();
         if self.sample.is_empty() {
-            self.sample = sample_cells(&self.layout);
+            self.sample = sample_cells(&self.whole);
         }
         // the padded field, rebuilt when the scan reaches farther than it was built for
         let field = match &mut self.field {
             Some(f) if f.reach >= reach => &*f,
             slot => &*slot.insert(PaddedField::new(&map.field, reach.max(1.0))),
         };
-        let layout = &self.layout;
+        let (layout, whole) = (&self.layout, &self.whole);
         let (sample, sub) = (&self.sample, &self.sub_cell);
         let sampled: Vec<Vec<f32>> = self
             .scratch
@@ -99,7 +100,7 @@ impl MarkovGrid {
                 }
                 let mut v = Vec::with_capacity(sample[k].len());
                 correction::cells_log_likelihood(
-                    field, &tables, layout, &offsets, &sample[k], &mut v,
+                    field, &tables, whole, &offsets, &sample[k], &mut v,
                 );
                 v
             })
@@ -141,25 +142,31 @@ impl MarkovGrid {
             return None;
         }
         let lambda = self.config.likelihood_exponent as f32;
-        // selective update only when it skips at least half of the cells
-        let cells = self.layout.free_count() * self.layout.n_theta;
-        let before = match self.carried.take() {
-            Some(c) => c,
-            None => {
-                let mut t = belief_ops::Tally::default();
-                t.add(&self.belief);
-                Carried::of(&t)
-            }
+        let tallied = |g: &Self| {
+            let mut t = belief_ops::Tally::default();
+            t.add(&g.belief);
+            g.carry(&t)
         };
-        let threshold = self.threshold(before.peak);
+        let mut before = self.carried.take().unwrap_or_else(|| tallied(self));
+        let mut threshold = self.threshold(before.peak);
+        // the cells outside the window count again once the background reaches the threshold
+        if self.is_windowed()
+            && (self.background() >= threshold || self.config.selective_threshold <= 0.0)
+        {
+            self.unwindow();
+            before = tallied(self);
+            threshold = self.threshold(before.peak);
+        }
+        // selective update only when it skips at least half of the cells (always on a window)
+        let cells = self.layout.free_count() * self.layout.n_theta;
         let selective = (self.config.selective_threshold > 0.0)
             .then(|| self.active_runs(threshold))
-            .filter(|(_, n)| 2 * n < cells);
+            .filter(|(_, n)| self.is_windowed() || 2 * n < cells);
         let sampled = self.score(map, points, range_max, selective.as_ref().map(|a| &a.0[..]));
         let l = &self.layout;
         // the belief's sum after the weighing, and, for the selective update, the weight of the
         // cells it did not score (the scored ones hold their weighed values in the scratch)
-        let (total, unscored) = match selective {
+        let (total, unscored) = match &selective {
             None => {
                 let best = self
                     .belief
@@ -214,6 +221,7 @@ impl MarkovGrid {
                             }
                         }
                     }
+                    // (before.sum holds the mass outside the window too)
                     let rest = (before.sum - unweighed).max(0.0) * floor as f64;
                     (rest + weighed, Some((threshold, floor)))
                 } else {
@@ -233,7 +241,10 @@ impl MarkovGrid {
         let mix = self.config.uniform_mix as f32;
         let l = &self.layout;
         let (keep, u) = if mix > 0.0 {
-            (1.0 - mix, mix / (l.free_count() * l.n_theta).max(1) as f32)
+            (
+                1.0 - mix,
+                mix / (self.whole.free_count() * l.n_theta).max(1) as f32,
+            )
         } else {
             (1.0, 0.0)
         };
@@ -255,12 +266,20 @@ impl MarkovGrid {
                 }
             }
         }
+        // the background as its cells: weighed by the floor, normalised, mixed
+        let floor = unscored.map_or(1.0, |(_, floor)| floor as f64);
+        self.outside = keep as f64 * (self.outside * floor * s as f64)
+            + u as f64 * self.outside_cells() as f64;
         // the most probable cell is the first holding the largest value (for positive, finite
         // values, the first maximum in total_cmp's order)
         let peak = t.peak();
-        self.carried = Some(Carried::of(&t));
-        (peak > 0.0)
+        self.carried = Some(self.carry(&t));
+        let best = (peak > 0.0)
             .then(|| belief_ops::find(&self.belief, peak))
-            .flatten()
+            .flatten();
+        match (unscored, selective) {
+            (Some(_), Some((runs, _))) => self.follow(&runs, best),
+            _ => best,
+        }
     }
 }
