@@ -10,9 +10,10 @@ use crate::localization::map::LocalizationMap;
 use correction::PaddedField;
 use rayon::prelude::*;
 
-/// Cells between two sample cells of the selective update (about 2 000 of the hospital's
-/// 0.97 million free cells × bins).
-const SAMPLE_STRIDE: usize = 487;
+/// Cells between two sample cells of the selective update (about 500 of the hospital's
+/// 0.97 million free cells × bins): the floor only weighs the cells below the threshold, whose
+/// share of the belief is too small for a finer average to change an estimate.
+const SAMPLE_STRIDE: usize = 1949;
 
 /// The selective update's sample: every `SAMPLE_STRIDE`-th cell in (layer, span) order, of the
 /// whole lattice.
