@@ -134,9 +134,9 @@ pub struct MarkovGrid {
 }
 
 /// What the pass that last wrote the belief tallied, valid until the belief changes otherwise:
-/// its sum with the mass outside the window (1 up to rounding after a correction, less after a motion that dropped mass, which
-/// the next correction's normalisation takes back) and its largest value (the selective
-/// threshold's scale).
+/// its sum with the mass outside the window (1 up to rounding after a correction, less after a
+/// motion that dropped mass, which the next correction's normalisation takes back) and its
+/// largest value (the selective threshold's scale).
 #[derive(Clone, Copy, Debug)]
 struct Carried {
     sum: f64,

@@ -1,11 +1,12 @@
-//! The belief's window. Once the belief has gathered, the selective update scores a few dozen
-//! cells of the lattice's million [Fox 1999b, §4.2], yet every pass of the prediction and the
+//! The belief's window. Once the belief has gathered, the selective update scores a few cells
+//! of the lattice's million [Fox 1999b, §4.2], yet every pass of the prediction and the
 //! correction still walked all of them. So the belief is then held cell by cell only on a
 //! rectangle of the lattice (all θ layers) around the cells at or above the selective threshold,
-//! [`super::WINDOW_MARGIN`] cells beyond them on every side; every free cell outside holds one value, the
-//! background: the mass outside spread evenly, which the correction weighs as the selective
-//! update weighs every cell it does not score (by the floor's likelihood), and the motion
-//! carries in where the window's cells come from outside it ([`super::prediction::Edge`]).
+//! [`super::WINDOW_MARGIN`] cells beyond them on every side; every free cell outside holds one
+//! value, the background: the mass outside spread evenly, which the correction weighs as the
+//! selective update weighs every cell it does not score (by the floor's likelihood), and the
+//! motion carries in where the window's cells come from outside it
+//! ([`super::prediction::Edge`]).
 //!
 //! The window follows the cells above the threshold, and the grid holds the whole lattice again
 //! whenever the window would not do: the background reaches the threshold (the robot is lost and
