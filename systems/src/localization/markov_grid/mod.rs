@@ -323,12 +323,12 @@ impl MarkovGrid {
         // a window is blurred as if nothing lay outside it (its edge cells lose the little mass
         // the blur moves outward), unless the kernel reaches past half its margin
         let reach = |var: f64| prediction::kernel_of_variance(var).len() / 2;
-        if self.pending_noise[0] >= BLUR_VARIANCE
+        if self.is_windowed()
+            && self.pending_noise[0] >= BLUR_VARIANCE
             && reach(self.pending_noise[0]) > WINDOW_MARGIN / 2
         {
+            // (the blur below tallies the whole lattice again)
             self.unwindow();
-            tally = belief_ops::Tally::default();
-            tally.add(&self.belief);
         }
         if self.pending_noise[0] >= BLUR_VARIANCE {
             let k = prediction::kernel_of_variance(self.pending_noise[0]);
