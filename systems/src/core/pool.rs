@@ -233,6 +233,44 @@ impl KernelPool {
         self.stay_awake();
     }
 
+    /// Runs `f` on every item, the dearest first: the items are ordered by `cost` (highest
+    /// first, ties in slice order) and each worker takes the next one as soon as it is free,
+    /// so the cheap items fill the gaps at the end instead of one worker finishing a dear item
+    /// alone (longest-processing-time-first list scheduling [Graham 1969]). For a few jobs of
+    /// unequal cost that changes slowly from call to call (a tick's localizers, each costed by
+    /// its last update). The items run inside the pool, so their own parallel kernels use it,
+    /// also when there is a single item. Results are the same as a loop over the items.
+    pub fn for_each_dearest_first<T: Send>(
+        &self,
+        items: &mut [T],
+        cost: impl Fn(&T) -> f64,
+        f: impl Fn(&mut T) + Send + Sync,
+    ) {
+        let threads = self.threads();
+        let parallel = threads > 1 && items.len() > 1;
+        let mut queue: Vec<(f64, &mut T)> = items.iter_mut().map(|t| (cost(&*t), t)).collect();
+        queue.sort_by(|a, b| b.0.total_cmp(&a.0)); // stable: ties keep slice order
+        let Some(pool) = self
+            .pool
+            .as_ref()
+            .filter(|p| parallel && p.current_thread_index().is_none())
+        else {
+            return self.install(|| queue.into_iter().for_each(|(_, t)| f(t)));
+        };
+        // each item is taken by one worker only (the cursor hands every index out once), so its
+        // lock is never contended; it makes the shared slice's items reachable from every worker
+        let cells: Vec<Mutex<&mut T>> = queue.into_iter().map(|(_, t)| Mutex::new(t)).collect();
+        let next = AtomicUsize::new(0);
+        self.section.fetch_add(1, Ordering::AcqRel);
+        pool.broadcast(|_| {
+            while let Some(cell) = cells.get(next.fetch_add(1, Ordering::Relaxed)) {
+                let mut item = cell.lock().unwrap_or_else(|e| e.into_inner());
+                f(&mut item);
+            }
+        });
+        self.stay_awake();
+    }
+
     /// [`KernelPool::for_each_init`] without scratch.
     pub fn for_each<T: Send>(&self, items: &mut [T], f: impl Fn(&mut T) + Send + Sync) {
         self.for_each_init(items, || (), |_, item| f(item));
@@ -307,6 +345,38 @@ mod tests {
             expected.sort_unstable();
             assert_eq!(seen, expected);
         }
+    }
+
+    /// Every item once, whatever the count and the threads, on the pool's workers (where a dear
+    /// item's own parallel kernels run); with one worker, the dearest first, ties in slice order.
+    #[test]
+    fn the_dearest_first_runs_every_item_once_dearest_first() {
+        for threads in [1, 2, 3] {
+            let pool = KernelPool::new(threads).unwrap();
+            for n in [0, 1, 2, 5, 64] {
+                let mut items: Vec<(usize, u32, bool)> = (0..n).map(|i| (i, 0, false)).collect();
+                pool.for_each_dearest_first(
+                    &mut items,
+                    |&(i, _, _)| (i % 7) as f64,
+                    |(_, runs, in_pool)| {
+                        *runs += 1;
+                        *in_pool = rayon::current_thread_index().is_some();
+                    },
+                );
+                assert!(items.iter().all(|&(_, runs, _)| runs == 1), "{items:?}");
+                assert!(items.iter().all(|&(_, _, in_pool)| in_pool), "{items:?}");
+            }
+        }
+        let one = KernelPool::new(1).unwrap();
+        let mut items: Vec<(usize, f64)> =
+            [1.0, 5.0, 2.0, 5.0, 0.5].into_iter().enumerate().collect();
+        let order = Mutex::new(Vec::new());
+        one.for_each_dearest_first(
+            &mut items,
+            |&(_, c)| c,
+            |&mut (i, _)| order.lock().unwrap().push(i),
+        );
+        assert_eq!(order.into_inner().unwrap(), [1, 3, 2, 0, 4]);
     }
 
     /// Every item once, whatever the count, the threads and how slow some items are; each

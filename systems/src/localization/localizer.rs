@@ -11,7 +11,6 @@ use super::scan_estimator::ScanEstimator;
 use crate::core::{KernelPool, Pose2};
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
-use rayon::prelude::*;
 use std::sync::OnceLock;
 
 /// One localization algorithm with its state.
@@ -158,6 +157,9 @@ pub struct UpdateCost {
     pub total_s: f64,
     /// The dearest one (s).
     pub max_s: f64,
+    /// The latest one (s): what the next is expected to cost, to hand the dearest localizers
+    /// out first.
+    pub latest_s: f64,
 }
 
 impl UpdateCost {
@@ -165,6 +167,7 @@ impl UpdateCost {
         self.updates += 1;
         self.total_s += seconds;
         self.max_s = self.max_s.max(seconds);
+        self.latest_s = seconds;
     }
 
     /// Mean cost of an update (s); 0 before the first.
@@ -424,10 +427,12 @@ pub fn feed_robots(
             loc.consume(map, scan.scan.stamp, scan, at);
         }
     };
-    match jobs.len() {
-        0 => {}
-        1 => pool.install(|| run(&mut jobs[0])),
-        _ => pool.install(|| jobs.par_iter_mut().for_each(run)),
+    // a localizer's cost changes slowly from tick to tick: its latest update's, once per scan
+    let expected = |(loc, input): &(&mut Localizer, &[(ScanInput, Pose2)])| {
+        loc.cost.latest_s * input.len() as f64
+    };
+    if !jobs.is_empty() {
+        pool.for_each_dearest_first(&mut jobs, expected, run);
     }
 }
 

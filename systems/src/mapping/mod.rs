@@ -47,7 +47,7 @@ pub use rbpf::{RbpfConfig, RbpfSlam};
 pub use scan_to_map::{ScanToMapConfig, ScanToMapSlam};
 
 use crate::core::{KernelPool, SimPlugin, SimSet};
-use crate::localization::{LocalizationMap, Localizers, WheelOdometry};
+use crate::localization::{LocalizationMap, Localizers, RobotFeed, WheelOdometry, feed_robots};
 use crate::sensors::{Laser, LaserScans};
 use bevy_ecs::prelude::*;
 
@@ -69,8 +69,17 @@ pub fn run_slam(
     pool: Res<KernelPool>,
     mut robots: Query<(&mut Localizers, &LaserScans, &Laser, &WheelOdometry)>,
 ) {
-    let map = map.as_deref();
-    for (mut locs, scans, laser, odom) in robots.iter_mut() {
-        locs.feed(map, &pool, scans, laser.spec.mount, odom, |f| f.is_scan());
-    }
+    // every robot's in one parallel section, as the localizers are fed; scans of a faulted
+    // laser never come, so the SLAM systems are fed as if it worked (no degraded state)
+    let mut feeds: Vec<RobotFeed> = robots
+        .iter_mut()
+        .map(|(locs, scans, laser, odom)| RobotFeed {
+            localizers: locs.into_inner(),
+            scans,
+            mount: laser.spec.mount,
+            odom,
+            laser_works: true,
+        })
+        .collect();
+    feed_robots(map.as_deref(), &pool, &mut feeds, |f| f.is_scan());
 }
