@@ -179,6 +179,10 @@ impl MapLocalizer for DeFilter {
         self.config.max_beams
     }
 
+    fn due(&self, odom: &Pose2) -> bool {
+        self.tracker.due(odom, &self.config.cycle())
+    }
+
     fn predict(&mut self, odom: &Pose2) -> bool {
         self.tracker.predict(odom, &self.config.cycle())
     }

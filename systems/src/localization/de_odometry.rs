@@ -175,15 +175,17 @@ impl MapLocalizer for DeOdometry {
         self.config.max_beams
     }
 
-    fn predict(&mut self, odom: &Pose2) -> bool {
-        if let Some(key) = &self.key {
+    fn due(&self, odom: &Pose2) -> bool {
+        self.key.as_ref().is_none_or(|key| {
             let guess = key.odom.inverse().compose(odom);
             let turned = crate::core::wrap_angle(guess.theta).abs();
-            if guess.x.hypot(guess.y) < self.config.update_min_d
-                && turned < self.config.update_min_a
-            {
-                return false;
-            }
+            guess.x.hypot(guess.y) >= self.config.update_min_d || turned >= self.config.update_min_a
+        })
+    }
+
+    fn predict(&mut self, odom: &Pose2) -> bool {
+        if !self.due(odom) {
+            return false;
         }
         self.pending = Some(*odom);
         true

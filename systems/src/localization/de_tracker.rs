@@ -179,14 +179,20 @@ impl DeTracker {
         }
     }
 
+    /// What [`DeTracker::predict`] would answer, without moving anything.
+    pub fn due(&self, odom: &Pose2, s: &CycleSettings) -> bool {
+        self.last_odom
+            .is_none_or(|last| moved_enough(&last, odom, s.update_min_d, s.update_min_a))
+    }
+
     /// The motion half of [`DeTracker::update`]: false (nothing changed) unless this is the first
     /// scan or the odometry has moved enough since the last update; otherwise the population
     /// moves by the odometry since then.
     pub fn predict(&mut self, odom: &Pose2, s: &CycleSettings) -> bool {
+        if !self.due(odom, s) {
+            return false;
+        }
         if let Some(last) = self.last_odom {
-            if !moved_enough(&last, odom, s.update_min_d, s.update_min_a) {
-                return false;
-            }
             let d = s.motion.delta(&last, odom);
             self.step_sd = d.end_sd();
             let lead = self.population.leader(self.gate().as_ref());

@@ -39,6 +39,15 @@ impl Filter {
         }
     }
 
+    /// Whether a scan at odometry pose `odom` would be corrected with (see
+    /// [`MapLocalizer::due`]); a SLAM system takes every scan.
+    pub fn due(&self, odom: &Pose2) -> bool {
+        match self {
+            Filter::Map(f) => f.due(odom),
+            Filter::Scan(_) => true,
+        }
+    }
+
     /// The latest estimate.
     pub fn estimate(&self) -> Option<PoseEstimate> {
         match self {
@@ -148,6 +157,10 @@ pub struct Localizer {
     anchor: Option<Anchor>,
 }
 
+/// The weight of the newest scan in [`UpdateCost::due_s`]: the cost follows a filter from its
+/// global start (dear) into tracking (cheap) within a few updates.
+const DUE_COST_WEIGHT: f64 = 0.3;
+
 /// What a localizer's updates cost in wall-clock time (one update = one scan consumed).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct UpdateCost {
@@ -157,17 +170,21 @@ pub struct UpdateCost {
     pub total_s: f64,
     /// The dearest one (s).
     pub max_s: f64,
-    /// The latest one (s): what the next is expected to cost, to hand the dearest localizers
-    /// out first.
-    pub latest_s: f64,
+    /// What a scan the filter corrects with costs (s), a moving average over those scans: the
+    /// others (not moved enough since the last update) cost next to nothing. The hint that
+    /// hands a tick's dearest localizers out first.
+    pub due_s: f64,
 }
 
 impl UpdateCost {
-    fn add(&mut self, seconds: f64) {
+    /// One scan consumed in `seconds`; `due`: one the filter corrected with.
+    fn add(&mut self, seconds: f64, due: bool) {
         self.updates += 1;
         self.total_s += seconds;
         self.max_s = self.max_s.max(seconds);
-        self.latest_s = seconds;
+        if due {
+            self.due_s += DUE_COST_WEIGHT * (seconds - self.due_s);
+        }
     }
 
     /// Mean cost of an update (s); 0 before the first.
@@ -201,9 +218,10 @@ impl Localizer {
         scan: &ScanInput,
         odom: &Pose2,
     ) {
+        let due = self.filter.due(odom);
         let started = std::time::Instant::now();
         if self.update(map, scan_stamp, scan, odom) {
-            self.cost.add(started.elapsed().as_secs_f64());
+            self.cost.add(started.elapsed().as_secs_f64(), due);
         }
     }
 
@@ -427,9 +445,14 @@ pub fn feed_robots(
             loc.consume(map, scan.scan.stamp, scan, at);
         }
     };
-    // a localizer's cost changes slowly from tick to tick: its latest update's, once per scan
+    // only a scan the filter corrects with costs something, about what the last ones did; the
+    // few centimetres of a tick's scans bring at most one by the filters' update thresholds
     let expected = |(loc, input): &(&mut Localizer, &[(ScanInput, Pose2)])| {
-        loc.cost.latest_s * input.len() as f64
+        if input.iter().any(|(_, at)| loc.filter.due(at)) {
+            loc.cost.due_s
+        } else {
+            0.0
+        }
     };
     if !jobs.is_empty() {
         pool.for_each_dearest_first(&mut jobs, expected, run);
@@ -472,6 +495,85 @@ mod tests {
     /// A scan with no usable beam (all NaN, zero, negative, below the minimum or at the
     /// maximum range) leaves a map localizer degraded, publishing its last estimate carried by
     /// the odometry, as a faulted laser does; the next scan with returns ends it.
+    /// Every map localizer takes a scan exactly when the odometry has moved its update
+    /// threshold (9 cm or 0.2 rad here) since the last scan it took, and `due` says so before
+    /// `predict`: at 2 cm and 1° a scan, every fifth.
+    #[test]
+    fn map_localizers_take_the_scans_due_by_their_thresholds() {
+        use crate::localization::de_filter::{DeFilter, DeFilterConfig};
+        use crate::localization::de_mc::{DeMc, DeMcConfig};
+        use crate::localization::de_odometry::{DeOdometry, DeOdometryConfig};
+        use crate::localization::{MapLocalizer, MarkovGrid, MarkovGridConfig};
+        let map = room();
+        let rng = |name: &str| stream_rng(1, "test", name);
+        let (d, a) = (0.09, 0.2);
+        let filters: Vec<Box<dyn MapLocalizer>> = vec![
+            Box::new(Mcl::new(
+                MclConfig {
+                    min_particles: 100,
+                    max_particles: 300,
+                    update_min_d: d,
+                    update_min_a: a,
+                    ..MclConfig::default()
+                },
+                &map,
+                rng("mcl"),
+            )),
+            Box::new(MarkovGrid::new(
+                MarkovGridConfig {
+                    update_min_d: d,
+                    update_min_a: a,
+                    ..MarkovGridConfig::default()
+                },
+                &map,
+            )),
+            Box::new(DeFilter::new(
+                DeFilterConfig {
+                    population: 60,
+                    min_population: 20,
+                    update_min_d: d,
+                    update_min_a: a,
+                    ..DeFilterConfig::default()
+                },
+                &map,
+                rng("de"),
+            )),
+            Box::new(DeMc::new(
+                DeMcConfig {
+                    population: 60,
+                    update_min_d: d,
+                    update_min_a: a,
+                    ..DeMcConfig::default()
+                },
+                &map,
+                rng("de_mc"),
+            )),
+            Box::new(DeOdometry::new(
+                DeOdometryConfig {
+                    update_min_d: d,
+                    update_min_a: a,
+                    ..DeOdometryConfig::default()
+                },
+                rng("de_odo"),
+            )),
+        ];
+        for mut f in filters {
+            let mut taken: Vec<usize> = Vec::new();
+            for k in 0..40 {
+                let odom = Pose2::new(5.0 + 0.02 * k as f64, 4.0, 0.3 + 0.0175 * k as f64);
+                let due = f.due(&odom);
+                assert_eq!(due, f.predict(&odom), "{} at scan {k}", f.kind());
+                if due {
+                    let scan = room_scan(&map, &odom, 90);
+                    f.correct(&map, &BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60));
+                    taken.push(k);
+                }
+            }
+            let every_fifth: Vec<usize> = (0..40).step_by(5).collect();
+            assert_eq!(taken, every_fifth, "{}", f.kind());
+        }
+    }
+
     #[test]
     fn scans_without_a_usable_beam_leave_the_localizer_degraded() {
         let map = room();

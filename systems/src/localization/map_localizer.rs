@@ -29,6 +29,14 @@ pub trait MapLocalizer: Send + Sync + Debug {
     /// with. False: skip this scan (e.g. not moved enough since the last update); then
     /// [`MapLocalizer::correct`] is not called for it.
     fn predict(&mut self, odom: &Pose2) -> bool;
+    /// What [`MapLocalizer::predict`] would answer for a scan at odometry pose `odom`, without
+    /// changing anything: whether the scan would be corrected with. Only a hint, for handing a
+    /// tick's localizers to the workers the dearest first (a skipped scan costs next to
+    /// nothing); true by default.
+    fn due(&self, odom: &Pose2) -> bool {
+        let _ = odom;
+        true
+    }
     /// Measurement update with the scan's beams on the map, after a `predict` that returned
     /// true. True if the filter updated: its [`MapLocalizer::estimate`] (if any) is then
     /// published at the scan's time.

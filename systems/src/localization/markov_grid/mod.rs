@@ -390,16 +390,22 @@ impl MapLocalizer for MarkovGrid {
         self.config.max_beams
     }
 
-    fn predict(&mut self, odom: &Pose2) -> bool {
-        if let Some(last) = self.last_odom {
-            if !moved_enough(
+    fn due(&self, odom: &Pose2) -> bool {
+        self.last_odom.is_none_or(|last| {
+            moved_enough(
                 &last,
                 odom,
                 self.config.update_min_d,
                 self.config.update_min_a,
-            ) {
-                return false;
-            }
+            )
+        })
+    }
+
+    fn predict(&mut self, odom: &Pose2) -> bool {
+        if !self.due(odom) {
+            return false;
+        }
+        if let Some(last) = self.last_odom {
             self.move_belief(&last, odom);
         }
         self.last_odom = Some(*odom);
