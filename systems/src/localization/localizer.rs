@@ -464,11 +464,36 @@ pub fn feed_robots(
 pub fn run_localizers(
     map: Option<Res<LocalizationMap>>,
     pool: Res<KernelPool>,
-    mut robots: Query<(&mut Localizers, &LaserScans, &Laser, &WheelOdometry)>,
+    mut robots: FeedQuery,
 ) {
     let Some(map) = map else {
         return; // no robot carries a localizer
     };
+    feed_query(Some(&map), &pool, &mut robots, true, |f| !f.is_scan());
+}
+
+/// The robots a localizing system queries: their localizers, scans, laser and odometry.
+pub type FeedQuery<'w, 's> = Query<
+    'w,
+    's,
+    (
+        &'static mut Localizers,
+        &'static LaserScans,
+        &'static Laser,
+        &'static WheelOdometry,
+    ),
+>;
+
+/// [`feed_robots`] over a system's query, every robot in one parallel section. `faults`: a
+/// faulted laser leaves the map localizers degraded; without it the robot is fed as if its
+/// laser worked (the SLAM systems, whose scans simply stop coming).
+pub fn feed_query(
+    map: Option<&LocalizationMap>,
+    pool: &KernelPool,
+    robots: &mut FeedQuery,
+    faults: bool,
+    select: impl Fn(&Filter) -> bool + Sync,
+) {
     let mut feeds: Vec<RobotFeed> = robots
         .iter_mut()
         .map(|(locs, scans, laser, odom)| RobotFeed {
@@ -476,10 +501,10 @@ pub fn run_localizers(
             scans,
             mount: laser.spec.mount,
             odom,
-            laser_works: laser.enabled,
+            laser_works: laser.enabled || !faults,
         })
         .collect();
-    feed_robots(Some(&map), &pool, &mut feeds, |f| !f.is_scan());
+    feed_robots(map, pool, &mut feeds, select);
 }
 
 #[cfg(test)]

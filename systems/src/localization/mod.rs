@@ -27,9 +27,7 @@ pub(crate) mod props;
 #[cfg(test)]
 pub(crate) mod test_drive;
 
-pub use localizer::{
-    Filter, Localizer, Localizers, RobotFeed, StampedEstimate, UpdateCost, feed_robots,
-};
+pub use localizer::{Filter, Localizer, Localizers, StampedEstimate, UpdateCost};
 pub use map::LocalizationMap;
 pub use map_localizer::MapLocalizer;
 pub use markov_grid::{MarkovGrid, MarkovGridConfig};

@@ -47,8 +47,8 @@ pub use rbpf::{RbpfConfig, RbpfSlam};
 pub use scan_to_map::{ScanToMapConfig, ScanToMapSlam};
 
 use crate::core::{KernelPool, SimPlugin, SimSet};
-use crate::localization::{LocalizationMap, Localizers, RobotFeed, WheelOdometry, feed_robots};
-use crate::sensors::{Laser, LaserScans};
+use crate::localization::localizer::{FeedQuery, feed_query};
+use crate::localization::{LocalizationMap, Localizers};
 use bevy_ecs::prelude::*;
 
 /// Adds the SLAM systems' feed to the Map set.
@@ -64,22 +64,7 @@ impl SimPlugin for MappingPlugin {
 
 /// Map: every SLAM system (a [`crate::localization::Filter::Scan`] among a robot's localizers)
 /// consumes this tick's scans with the odometry pose at each scan's time.
-pub fn run_slam(
-    map: Option<Res<LocalizationMap>>,
-    pool: Res<KernelPool>,
-    mut robots: Query<(&mut Localizers, &LaserScans, &Laser, &WheelOdometry)>,
-) {
-    // every robot's in one parallel section, as the localizers are fed; scans of a faulted
-    // laser never come, so the SLAM systems are fed as if it worked (no degraded state)
-    let mut feeds: Vec<RobotFeed> = robots
-        .iter_mut()
-        .map(|(locs, scans, laser, odom)| RobotFeed {
-            localizers: locs.into_inner(),
-            scans,
-            mount: laser.spec.mount,
-            odom,
-            laser_works: true,
-        })
-        .collect();
-    feed_robots(map.as_deref(), &pool, &mut feeds, |f| f.is_scan());
+pub fn run_slam(map: Option<Res<LocalizationMap>>, pool: Res<KernelPool>, mut robots: FeedQuery) {
+    // scans of a faulted laser never come: no degraded state for the SLAM systems
+    feed_query(map.as_deref(), &pool, &mut robots, false, |f| f.is_scan());
 }
