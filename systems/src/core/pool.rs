@@ -238,7 +238,7 @@ impl KernelPool {
     /// so the cheap items fill the gaps at the end instead of one worker finishing a dear item
     /// alone (longest-processing-time-first list scheduling [Graham 1969]). For a few jobs of
     /// unequal cost that changes slowly from call to call (a tick's localizers, each costed by
-    /// its last update). The items run inside the pool, so their own parallel kernels use it,
+    /// its recent updates). The items run inside the pool, so their own parallel kernels use it,
     /// also when there is a single item. Results are the same as a loop over the items.
     pub fn for_each_dearest_first<T: Send>(
         &self,
