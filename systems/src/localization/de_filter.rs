@@ -165,6 +165,7 @@ impl DeFilterConfig {
             refine_sd: self.refine_sd,
             reseed: self.population,
             injection_candidates: self.injection_candidates,
+            temperature: 0.0,
         }
     }
 }

@@ -129,6 +129,7 @@ impl DeMcConfig {
             refine_sd: self.refine_sd,
             reseed: self.population,
             injection_candidates: self.injection_candidates,
+            temperature: self.temperature,
         }
     }
 }

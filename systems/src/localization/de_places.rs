@@ -6,36 +6,65 @@
 //! and sums its cost (mean range error) over the scans since it was found; the estimate follows
 //! the place of lowest sum, and the filter may declare itself converged only once that place
 //! leads every other by [`SETTLED`]: several scans' evidence, or one scan that tells the places
-//! apart.
+//! apart. A place found late starts behind the best (it must earn the lead), but that start is
+//! no evidence against it: the filter settles only once every other place has also trailed the
+//! leader by [`SETTLED`] on the scans it was seen on, so a robot's own ward found a few scans
+//! after its twin keeps the twin from settling. A place moves to a better-fitting member only as
+//! far as the odometry's prior allows ([`Prior`]), as a converged filter's estimate does.
 //!
 //! The sums are of costs, not of log-likelihoods under a per-beam noise model: what tells
 //! look-alike places apart is a few beams that see a different doorway or corridor end, and a
 //! noise model fitted to the scan (a Laplace scale from the best fit, tempered as the Markov
 //! grid's likelihood) rated such differences so highly that the filter settled on a twin again.
 
-use super::de_population::{Population, RangeMetric, close, range_costs};
+use super::de_population::{Gate, Population, RangeMetric, close, range_costs};
 use super::map::LocalizationMap;
 use super::mcl::BeamSubset;
 use crate::core::Pose2;
 
 /// The summed cost (m of mean range error for L1, m² for L2) by which the best place must lead
-/// every other.
+/// every other, and a newcomer's start behind it.
 pub const SETTLED: f64 = 0.15;
 /// A place whose sum trails the best's by more than this is dropped.
 const DROP: f64 = 0.6;
 /// A member starts a place if its cost is at most this multiple of the best place's.
-const PLAUSIBLE: f64 = 1.25;
+pub const PLAUSIBLE: f64 = 1.25;
 /// Places kept at most.
 const MAX_PLACES: usize = 8;
 /// Members within this distance (m) and turn (rad) of a place belong to it.
-const RADIUS: f64 = 1.0;
-const ANGLE: f64 = 0.3;
+pub const RADIUS: f64 = 1.0;
+pub const ANGLE: f64 = 0.3;
 
-/// One place: its pose and its cost summed over the scans since it was found.
+/// One place: its pose, its cost summed over the scans since it was found (a newcomer's
+/// starting behind), and by how much its costs exceeded the leading place's over those scans.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Place {
     pose: [f64; 3],
     sum: f64,
+    trail: f64,
+}
+
+/// How far a place believes the odometry that carried it: the spread of a [`Gate`]'s prior
+/// (m, rad) and its cost per nat. A place moves to a member of its reach only if that member
+/// fits better by more than its distance costs under this prior, so a place does not slide
+/// along a corridor to whichever of many chains fitted one scan marginally better.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prior {
+    pub sigma: [f64; 2],
+    pub cost_per_nat: f64,
+}
+
+impl Prior {
+    /// The gate of a place at `pose`.
+    fn around(&self, pose: &[f64; 3]) -> Gate {
+        Gate {
+            centre: *pose,
+            radius: RADIUS,
+            angle: ANGLE,
+            sigma: self.sigma,
+            cost_per_nat: self.cost_per_nat,
+        }
+    }
 }
 
 /// The places of a searching filter, best first after [`Places::update`].
@@ -68,17 +97,19 @@ impl Places {
     }
 
     /// Weighs the places on the scan the population was just scored on: each place moves to its
-    /// best member if that fits better than its own pose, adds its cost to its sum, and every
-    /// plausible member away from the known places starts a new one (behind the best place by
-    /// [`SETTLED`] once there is one: a newcomer must earn the lead). Returns the member the
-    /// estimate follows (the best place's; its pose replaces the worst member if no member is
-    /// near it) and whether that place has settled.
+    /// best member if that fits better than its own pose under the `prior`, adds its cost to its
+    /// sum, and every plausible member away from the known places starts a new one (behind the
+    /// best place by [`SETTLED`] once there is one: a newcomer must earn the lead). Returns the
+    /// member the estimate follows (the best place's; its pose replaces the worst member if no
+    /// member is near it) and whether that place has settled: it leads every other place by
+    /// [`SETTLED`] both in its sum and on the scans that place was seen on.
     pub fn update(
         &mut self,
         pop: &mut Population,
         map: &LocalizationMap,
         beams: &BeamSubset,
         metric: RangeMetric,
+        prior: &Prior,
     ) -> (usize, bool) {
         if pop.is_empty() {
             return (0, false);
@@ -90,9 +121,9 @@ impl Places {
         let mut member: Vec<Option<usize>> = Vec::with_capacity(MAX_PLACES);
         let mut costs: Vec<f64> = Vec::with_capacity(MAX_PLACES);
         for (p, &c) in self.places.iter_mut().zip(&own_costs) {
-            let near = nearest_best(pop, &p.pose);
-            match near {
-                Some(i) if pop.costs[i] < c => {
+            let gate = prior.around(&p.pose);
+            match nearest_best(pop, &gate) {
+                Some(i) if gate.weighed(&pop.poses[i], pop.costs[i]) < c => {
                     p.pose = pop.poses[i];
                     member.push(Some(i));
                     costs.push(pop.costs[i]);
@@ -127,6 +158,7 @@ impl Places {
             self.places.push(Place {
                 pose: p,
                 sum: newcomer,
+                trail: 0.0,
             });
             member.push(Some(i));
             costs.push(pop.costs[i]);
@@ -139,9 +171,13 @@ impl Places {
             let (pa, pb) = (&self.places[a], &self.places[b]);
             pa.sum.total_cmp(&pb.sum).then(a.cmp(&b))
         });
-        let Some(best_sum) = ranked.first().map(|&k| self.places[k].sum) else {
+        let Some(&first) = ranked.first() else {
             return (pop.best(), false);
         };
+        let (best_sum, best_cost) = (self.places[first].sum, costs[first]);
+        for (p, c) in self.places.iter_mut().zip(&costs) {
+            p.trail += c - best_cost;
+        }
         let mut kept: Vec<(Place, Option<usize>, f64)> = Vec::with_capacity(MAX_PLACES);
         for k in ranked {
             let p = self.places[k];
@@ -158,10 +194,13 @@ impl Places {
             kept.push((p, member[k], costs[k]));
         }
         self.places = kept.iter().map(|k| k.0).collect();
+        // a newcomer's start behind ranks it, but only the scans it was seen on tell it apart:
+        // a look-alike found late must trail on its own evidence too
         let settled = self
             .places
-            .get(1)
-            .is_none_or(|q| q.sum - best_sum >= SETTLED);
+            .iter()
+            .skip(1)
+            .all(|q| q.sum - best_sum >= SETTLED && q.trail >= SETTLED);
         let Some(&(first, at, cost)) = kept.first() else {
             return (pop.best(), false);
         };
@@ -179,11 +218,37 @@ impl Places {
     }
 }
 
-/// The member of lowest cost within a place's reach of `pose`.
-fn nearest_best(pop: &Population, pose: &[f64; 3]) -> Option<usize> {
+/// The best member of each distinct place whose cost is within `margin` of the best member's,
+/// best first, at most [`MAX_PLACES`]: the members a sampling method refines before the places
+/// are weighed ([`super::de_tracker`]).
+pub fn modes(pop: &Population, margin: f64) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..pop.len()).collect();
+    order.sort_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(a.cmp(&b)));
+    let Some(&first) = order.first() else {
+        return Vec::new();
+    };
+    let bound = pop.costs[first] + margin;
+    let mut out: Vec<usize> = Vec::with_capacity(MAX_PLACES);
+    for i in order {
+        if out.len() == MAX_PLACES || pop.costs[i].total_cmp(&bound).is_gt() {
+            break;
+        }
+        if out
+            .iter()
+            .all(|&k| !close(&pop.poses[i], &pop.poses[k], RADIUS, ANGLE))
+        {
+            out.push(i);
+        }
+    }
+    out
+}
+
+/// The member of lowest cost within a place's `gate`, weighed by its prior.
+fn nearest_best(pop: &Population, gate: &Gate) -> Option<usize> {
+    let weighed = |i: usize| gate.weighed(&pop.poses[i], pop.costs[i]);
     (0..pop.len())
-        .filter(|&i| close(&pop.poses[i], pose, RADIUS, ANGLE))
-        .min_by(|&a, &b| pop.costs[a].total_cmp(&pop.costs[b]).then(a.cmp(&b)))
+        .filter(|&i| gate.contains(&pop.poses[i]))
+        .min_by(|&a, &b| weighed(a).total_cmp(&weighed(b)).then(a.cmp(&b)))
 }
 
 #[cfg(test)]
@@ -201,15 +266,36 @@ mod tests {
     /// A laser five times noisier than the LMS100 (or a crowd in view).
     const NOISE: f64 = 0.06;
 
-    /// Driving west from the start, the robot's place and its twin fit the first scans alike: the
-    /// places do not settle on them, and once the scans tell them apart (after about 2.5 m) the
-    /// robot's place leads by [`SETTLED`], the estimate follows it and the twin is dropped.
-    #[test]
-    fn look_alike_places_settle_only_once_the_scans_tell_them_apart() {
+    /// The gate prior of the tests: a 2 cm, 0.6° spread, a cost of 0.1 worth a nat per beam.
+    const PRIOR: Prior = Prior {
+        sigma: [0.02, 0.01],
+        cost_per_nat: 0.1 / 60.0,
+    };
+
+    /// A noisy scan from `truth`, 60 beams of it.
+    fn noisy_beams(
+        map: &LocalizationMap,
+        truth: &Pose2,
+        rng: &mut crate::core::SimRng,
+    ) -> BeamSubset {
+        let mut scan = scan_at(map, truth, rng);
+        for r in scan.ranges.iter_mut().filter(|r| r.is_finite()) {
+            let e: f64 = StandardNormal.sample(rng);
+            *r += NOISE as f32 * e as f32;
+        }
+        BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60)
+    }
+
+    /// Drives west from r4's start with a member at the twin and, from update `found` on, one at
+    /// the robot's place; returns the update after which the places settled. Whenever they are
+    /// settled from then on, the estimate follows the robot's place; the twin is dropped in the
+    /// end.
+    fn settle_with_the_robot_found_at(found: usize) -> usize {
         let map = hospital();
         let mut rng = stream_rng(2, "test", "places");
+        // until it is found, the robot's member stands where no scan fits
         let mut pop = Population {
-            poses: vec![TWIN, TRUTH, [10.0, 7.0, 0.0]],
+            poses: vec![TWIN, [10.0, 14.0, 1.0], [10.0, 7.0, 0.0]],
             costs: vec![0.0; 3],
         };
         let mut places = Places::default();
@@ -225,22 +311,22 @@ mod tests {
                     *p = [q.x, q.y, q.theta];
                 }
             }
-            let mut scan = scan_at(&map, &truth, &mut rng);
-            for r in scan.ranges.iter_mut().filter(|r| r.is_finite()) {
-                let e: f64 = StandardNormal.sample(&mut rng);
-                *r += NOISE as f32 * e as f32;
+            if k == found {
+                pop.poses[1] = [truth.x, truth.y, truth.theta];
             }
-            let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60);
+            let beams = noisy_beams(&map, &truth, &mut rng);
             pop.evaluate(&map, &beams, RangeMetric::L1);
-            if k == 0 {
-                // the twin is a look-alike: it fits the first scan about as well
+            if k == found {
+                // the twin is a look-alike: it fits the scan about as well
                 assert!(pop.costs[0] < PLAUSIBLE * pop.costs[1], "{:?}", pop.costs);
             }
-            let (lead, settled) = places.update(&mut pop, &map, &beams, RangeMetric::L1);
+            let (lead, settled) = places.update(&mut pop, &map, &beams, RangeMetric::L1, &PRIOR);
             assert!(places.len() <= 2, "update {k}");
-            if k == 0 {
+            if k == found {
                 assert!(places.len() == 2 && !settled);
             }
+            // (alone, the twin settles before the robot's place is found)
+            let settled = settled && k >= found;
             if settled && settled_at.is_none() {
                 settled_at = Some(k);
             }
@@ -249,9 +335,54 @@ mod tests {
                 assert!(at.distance(&truth) < 0.1, "update {k}: {at:?} {truth:?}");
             }
         }
-        // the corridors look alike for the first 2.5 m
-        let k = settled_at.expect("never settled");
-        assert!((5..=20).contains(&k), "settled after {k} updates");
         assert_eq!(places.len(), 1, "the twin is dropped once far behind");
+        settled_at.expect("never settled")
+    }
+
+    /// Driving west from the start, the robot's place and its twin fit the first scans alike: the
+    /// places do not settle on them, and once the scans tell them apart (after about 2.5 m) the
+    /// robot's place leads by [`SETTLED`], the estimate follows it and the twin is dropped.
+    #[test]
+    fn look_alike_places_settle_only_once_the_scans_tell_them_apart() {
+        let k = settle_with_the_robot_found_at(0);
+        assert!((5..=20).contains(&k), "settled after {k} updates");
+    }
+
+    /// The robot's place found three scans after its twin starts behind it, but the twin may not
+    /// settle while the two fit alike: the newcomer must trail on the scans it was seen on.
+    #[test]
+    fn a_look_alike_found_late_keeps_the_places_from_settling() {
+        let k = settle_with_the_robot_found_at(3);
+        assert!((8..=35).contains(&k), "settled after {k} updates");
+    }
+
+    /// A place does not slide along the corridor to a member half a metre ahead that fits one
+    /// scan marginally better; it moves to one a centimetre away that fits better.
+    #[test]
+    fn a_place_moves_to_a_better_member_only_as_far_as_its_prior_allows() {
+        let map = hospital();
+        let mut rng = stream_rng(3, "test", "places");
+        let truth = Pose2::new(TRUTH[0], TRUTH[1], TRUTH[2]);
+        let beams = noisy_beams(&map, &truth, &mut rng);
+        let mut places = Places::default();
+        let mut pop = Population {
+            poses: vec![TRUTH],
+            costs: vec![0.0],
+        };
+        pop.evaluate(&map, &beams, RangeMetric::L1);
+        let own = pop.costs[0];
+        places.update(&mut pop, &map, &beams, RangeMetric::L1, &PRIOR);
+        let ahead = truth.compose(&Pose2::new(0.5, 0.0, 0.0));
+        let near = truth.compose(&Pose2::new(0.01, 0.0, 0.0));
+        let mut pop = Population {
+            poses: vec![
+                [ahead.x, ahead.y, ahead.theta],
+                [near.x, near.y, near.theta],
+            ],
+            costs: vec![own - 0.004, own - 0.001],
+        };
+        let (lead, _) = places.update(&mut pop, &map, &beams, RangeMetric::L1, &PRIOR);
+        assert_eq!(lead, 1);
+        assert_eq!(places.places[0].pose, pop.poses[1]);
     }
 }

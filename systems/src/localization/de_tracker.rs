@@ -7,8 +7,8 @@
 //! and the estimate; once a converged filter is lost, a fresh population spread over the whole
 //! floor searches again.
 
-use super::de_places::Places;
-use super::de_population::{ESTIMATE_FLOOR, Gate, Population, RangeMetric, convergence};
+use super::de_places::{ANGLE as PLACE_ANGLE, Places, Prior, RADIUS as PLACE_RADIUS, modes};
+use super::de_population::{ESTIMATE_FLOOR, Gate, Population, RangeMetric, close, convergence};
 use super::map::LocalizationMap;
 use super::mcl::injection::scan_proposal;
 use super::mcl::sensor_model::likelihood_table;
@@ -33,6 +33,9 @@ pub struct CycleSettings<'a> {
     /// Candidates per round of the scan proposal that replaces the worst members while the
     /// filter searches (0: off).
     pub injection_candidates: usize,
+    /// The temperature at which the method's members sample around the best poses of their
+    /// places (DE-MC's T); 0 for a method whose selection keeps only improvements.
+    pub temperature: f64,
 }
 
 /// The state of a DE localizer apart from its method's own parameters.
@@ -62,6 +65,10 @@ pub struct DeTracker {
     /// While searching: the look-alike places weighed over several scans.
     places: Places,
 }
+
+/// Places whose best member is within this many chains' mean excess cost of the best member
+/// are refined while a sampling method searches ([`DeTracker::refine_modes`]).
+const MODE_EXCESS: f64 = 3.0;
 
 /// A challenger must cost at most this share of the leader's cost…
 const CHALLENGE_RATIO: f64 = 0.8;
@@ -100,14 +107,23 @@ impl DeTracker {
     /// the motion's noise.
     fn gate(&self) -> Option<Gate> {
         let t = self.tracked.filter(|_| self.converged)?;
-        let sd = |k: usize| PRIOR_FLOOR[k].hypot(self.step_sd[k]);
+        let prior = self.prior();
         Some(Gate {
             centre: [t.x, t.y, t.theta],
             radius: 1.0,
             angle: 0.3,
+            sigma: prior.sigma,
+            cost_per_nat: prior.cost_per_nat,
+        })
+    }
+
+    /// The prior around where the odometry carried a pose since the last update.
+    fn prior(&self) -> Prior {
+        let sd = |k: usize| PRIOR_FLOOR[k].hypot(self.step_sd[k]);
+        Prior {
             sigma: [sd(0), sd(1)],
             cost_per_nat: self.cost_per_nat,
-        })
+        }
     }
 
     /// Consumes a scan taken at odometry pose `odom`; `evolve(tracker, converged)` runs the
@@ -177,6 +193,46 @@ impl DeTracker {
         for (&i, &(x, y, th)) in order.iter().zip(&pool) {
             p.poses[i] = [x, y, th];
         }
+    }
+
+    /// While searching with a sampling method: refines the best member of every other place
+    /// within [`MODE_EXCESS`] sampling excesses of the best cost, as the leader (`lead`) was.
+    /// The chains sample exp(−m·cost/T) over m beams [ter Braak 2006], near a place's minimum a
+    /// Gaussian in three dimensions, so they sit on average 3T/2m above it, while the leader's
+    /// refined cost sits at its minimum: unrefined, the robot's own place could never look as
+    /// plausible as a refined look-alike to [`Places::update`]. Returns the evaluations.
+    fn refine_modes(
+        &mut self,
+        map: &LocalizationMap,
+        beams: &BeamSubset,
+        s: &CycleSettings,
+        lead: usize,
+    ) -> u64 {
+        let margin = MODE_EXCESS * 1.5 * s.temperature / beams.len().max(1) as f64;
+        let lead_pose = self.population.poses[lead];
+        let mut evaluations = 0;
+        for i in modes(&self.population, margin) {
+            if close(
+                &self.population.poses[i],
+                &lead_pose,
+                PLACE_RADIUS,
+                PLACE_ANGLE,
+            ) {
+                continue;
+            }
+            evaluations += self.population.refine_best(
+                map,
+                beams,
+                s.metric,
+                i,
+                None,
+                s.refine_rounds,
+                s.refine_samples,
+                s.refine_sd,
+                &mut self.rng,
+            );
+        }
+        evaluations
     }
 
     /// What [`DeTracker::predict`] would answer, without moving anything.
@@ -252,10 +308,14 @@ impl DeTracker {
         // and the filter converges only once that place stands out
         let mut settled = true;
         if !self.converged {
+            if s.temperature > 0.0 {
+                self.evaluations += self.refine_modes(map, beams, s, lead);
+            }
             self.evaluations += self.places.len() as u64;
-            (lead, settled) = self
-                .places
-                .update(&mut self.population, map, beams, s.metric);
+            let prior = self.prior();
+            (lead, settled) =
+                self.places
+                    .update(&mut self.population, map, beams, s.metric, &prior);
         }
         let was_converged = self.converged;
         (self.converged, self.streak) = convergence(
@@ -307,6 +367,57 @@ mod tests {
         t.converged = true;
         t.tracked = Some(Pose2::new(10.0, 7.0, 0.0));
         t
+    }
+
+    /// While a sampling method searches, the best chain at the robot's place (a few centimetres
+    /// off, as chains at temperature sit) is refined like the leader at its look-alike, so the
+    /// places can weigh the two alike; without a temperature there is no margin for it.
+    #[test]
+    fn a_sampling_method_refines_every_plausible_place_not_just_its_leader() {
+        use crate::localization::de_places::PLAUSIBLE;
+        use crate::localization::test_drive::scan_at;
+        let map = hospital();
+        let mut rng = stream_rng(5, "test", "modes");
+        // r4's start facing west along the north corridor, and the look-alike 27 m west
+        let truth = Pose2::new(61.8, 24.75, std::f64::consts::PI);
+        let scan = scan_at(&map, &truth, &mut rng);
+        let beams = BeamSubset::from_scan(&scan, &Pose2::IDENTITY, 60);
+        let motion = OdometryMotionModel::default();
+        let settings = |temperature: f64| CycleSettings {
+            motion: &motion,
+            update_min_d: 0.2,
+            update_min_a: 0.5,
+            metric: RangeMetric::L1,
+            converge_cost: 0.1,
+            converge_updates: 3,
+            refine_rounds: 4,
+            refine_samples: 32,
+            refine_sd: [0.2, 0.2, 0.05],
+            reseed: 0,
+            injection_candidates: 0,
+            temperature,
+        };
+        let refined = |temperature: f64| {
+            let mut t = DeTracker::new(2, &InitialBelief::Global, &map, stream_rng(1, "t", "de"));
+            let off = truth.compose(&Pose2::new(0.02, -0.02, 0.003));
+            t.population = Population {
+                poses: vec![[34.8, 24.75, truth.theta], [off.x, off.y, off.theta]],
+                costs: vec![0.0; 2],
+            };
+            t.population.evaluate(&map, &beams, RangeMetric::L1);
+            let before = t.population.costs.clone();
+            t.refine_modes(&map, &beams, &settings(temperature), 0);
+            (before, t.population.costs)
+        };
+        let (before, after) = refined(0.5);
+        assert!(before[1] > PLAUSIBLE * before[0], "{before:?}");
+        assert!(after[1] <= PLAUSIBLE * after[0], "{after:?}");
+        assert_eq!(
+            after[0], before[0],
+            "the leader is refined by the cycle, not again"
+        );
+        let (_, greedy) = refined(0.0);
+        assert_eq!(greedy, before);
     }
 
     /// The estimate moves to a place outside the gate only after that place has fitted clearly
