@@ -29,7 +29,7 @@ pub const SETTLED: f64 = 0.15;
 const DROP: f64 = 0.6;
 /// A member starts a place if its cost is at most this multiple of the best place's.
 pub const PLAUSIBLE: f64 = 1.25;
-/// Places kept at most.
+/// Places kept by their sums at most; as many again that the scans have not ruled out.
 const MAX_PLACES: usize = 8;
 /// Members within this distance (m) and turn (rad) of a place belong to it.
 pub const RADIUS: f64 = 1.0;
@@ -178,21 +178,35 @@ impl Places {
         for (p, c) in self.places.iter_mut().zip(&costs) {
             p.trail += c - best_cost;
         }
-        let mut kept: Vec<(Place, Option<usize>, f64)> = Vec::with_capacity(MAX_PLACES);
-        for k in ranked {
-            let p = self.places[k];
-            if kept.len() == MAX_PLACES || p.sum > best_sum + DROP {
-                break;
+        // the best places by their sums, then any place followed so far that the scans it was
+        // seen on have not ruled out: a burst of newcomers, which start just behind the leader,
+        // must not push out a place that fits as well as the leader but trails by its own start
+        let mut keep: Vec<usize> = Vec::with_capacity(2 * MAX_PLACES);
+        for followed in [false, true] {
+            let cap = if followed { 2 * MAX_PLACES } else { MAX_PLACES };
+            for &k in &ranked {
+                let p = &self.places[k];
+                if keep.len() == cap || p.sum > best_sum + DROP {
+                    break;
+                }
+                let open = !followed || (k < own.len() && p.trail < SETTLED);
+                // two places that drifted together are one: the better sum stays
+                if !open
+                    || keep.contains(&k)
+                    || keep
+                        .iter()
+                        .any(|&q| close(&p.pose, &self.places[q].pose, RADIUS, ANGLE))
+                {
+                    continue;
+                }
+                keep.push(k);
             }
-            // two places that drifted together are one: the better sum stays
-            if kept
-                .iter()
-                .any(|q| close(&p.pose, &q.0.pose, RADIUS, ANGLE))
-            {
-                continue;
-            }
-            kept.push((p, member[k], costs[k]));
         }
+        keep.sort_by_key(|&k| ranked.iter().position(|&r| r == k));
+        let kept: Vec<(Place, Option<usize>, f64)> = keep
+            .iter()
+            .map(|&k| (self.places[k], member[k], costs[k]))
+            .collect();
         self.places = kept.iter().map(|k| k.0).collect();
         // a newcomer's start behind ranks it, but only the scans it was seen on tell it apart:
         // a look-alike found late must trail on its own evidence too
@@ -354,6 +368,47 @@ mod tests {
     fn a_look_alike_found_late_keeps_the_places_from_settling() {
         let k = settle_with_the_robot_found_at(3);
         assert!((8..=35).contains(&k), "settled after {k} updates");
+    }
+
+    /// A burst of plausible newcomers does not push out a followed place the scans have not
+    /// ruled out: the robot's own place, trailing its twin by no more than its start behind.
+    #[test]
+    fn newcomers_do_not_push_out_a_place_already_followed() {
+        let map = hospital();
+        let mut rng = stream_rng(4, "test", "places");
+        let truth = Pose2::new(TRUTH[0], TRUTH[1], TRUTH[2]);
+        let beams = noisy_beams(&map, &truth, &mut rng);
+        let mut places = Places {
+            places: vec![
+                Place {
+                    pose: TWIN,
+                    sum: 0.10,
+                    trail: 0.0,
+                },
+                Place {
+                    pose: TRUTH,
+                    sum: 0.26,
+                    trail: 0.0,
+                },
+            ],
+        };
+        let mut pop = Population {
+            poses: vec![TRUTH],
+            costs: vec![0.0],
+        };
+        pop.evaluate(&map, &beams, RangeMetric::L1);
+        let fit = pop.costs[0];
+        // members at MAX_PLACES other places, each fitting this scan well
+        pop.poses = (0..MAX_PLACES)
+            .map(|k| [5.0 + 3.0 * k as f64, 7.25, 0.0])
+            .collect();
+        pop.costs = vec![0.5 * fit; MAX_PLACES];
+        places.update(&mut pop, &map, &beams, RangeMetric::L1, &PRIOR);
+        assert_eq!(places.len(), MAX_PLACES + 1);
+        for kept in [TWIN, TRUTH] {
+            let at = |p: &Place| close(&p.pose, &kept, RADIUS, ANGLE);
+            assert!(places.places.iter().any(at), "{kept:?} dropped");
+        }
     }
 
     /// A place does not slide along the corridor to a member half a metre ahead that fits one

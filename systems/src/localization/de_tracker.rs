@@ -282,8 +282,14 @@ impl DeTracker {
         }
         self.population.evaluate(map, beams, s.metric);
         self.evaluations += self.population.len() as u64;
-        // a cost of `converge_cost` (a good fit's mean range error) is worth about a nat per beam
-        self.cost_per_nat = s.converge_cost / beams.len() as f64;
+        // a sampling method's target density exp(−m·cost/T) says what a nat of cost is; for a
+        // greedy one, a cost of `converge_cost` (a good fit's mean range error) is worth about a
+        // nat per beam
+        self.cost_per_nat = if s.temperature > 0.0 {
+            s.temperature
+        } else {
+            s.converge_cost
+        } / beams.len() as f64;
         let gate = self.gate();
         let lead = self.population.leader(gate.as_ref());
         self.evaluations += self.population.refine_best(
