@@ -233,7 +233,7 @@ impl Places {
 }
 
 /// The best member of each distinct place whose cost is within `margin` of the best member's,
-/// best first, at most [`MAX_PLACES`]: the members a sampling method refines before the places
+/// best first, at most eight: the members a sampling method refines before the places
 /// are weighed ([`super::de_tracker`]).
 pub fn modes(pop: &Population, margin: f64) -> Vec<usize> {
     let mut order: Vec<usize> = (0..pop.len()).collect();
