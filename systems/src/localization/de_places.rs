@@ -190,9 +190,9 @@ impl Places {
                     break;
                 }
                 let open = !followed || (k < own.len() && p.trail < SETTLED);
-                // two places that drifted together are one: the better sum stays
+                // two places that drifted together are one: the better sum stays (and a place
+                // kept by the first pass is close to itself)
                 if !open
-                    || keep.contains(&k)
                     || keep
                         .iter()
                         .any(|&q| close(&p.pose, &self.places[q].pose, RADIUS, ANGLE))
