@@ -111,6 +111,45 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
     format!("panicked: {msg}")
 }
 
+/// `work(i, &items[i])` for every item, on `workers` threads (0 = one per core; never more
+/// than the items), the results in item order. Each worker takes the next item from a shared
+/// counter and runs it to its end: a run started on a worker keeps it to itself, whatever pools
+/// its own kernels use (see the module's documentation). A panic in `work` reaches the caller
+/// once the workers are done.
+pub fn on_workers<I: Sync, T: Send>(
+    items: &[I],
+    workers: usize,
+    work: impl Fn(usize, &I) -> T + Sync,
+) -> anyhow::Result<Vec<T>> {
+    if items.is_empty() {
+        return Ok(Vec::new());
+    }
+    let workers = worker_count(workers, items.len());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(workers)
+        .thread_name(|i| format!("sim-worker-{i}"))
+        .build()
+        .map_err(|e| anyhow::anyhow!("cannot start {workers} worker threads: {e}"))?;
+    let next = AtomicUsize::new(0);
+    let done: Mutex<Vec<(usize, T)>> = Mutex::new(Vec::with_capacity(items.len()));
+    pool.broadcast(|_| {
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(item) = items.get(i) else { break };
+            let result = work(i, item);
+            // a worker that panicked outside `work` cannot have poisoned this lock while holding it
+            if let Ok(mut d) = done.lock() {
+                d.push((i, result));
+            }
+        }
+    });
+    let mut done = done
+        .into_inner()
+        .map_err(|_| anyhow::anyhow!("a worker failed"))?;
+    done.sort_by_key(|(i, _)| *i);
+    Ok(done.into_iter().map(|(_, t)| t).collect())
+}
+
 /// Runs `work` on every job with `workers` threads (0 = one per core; never more than the jobs),
 /// catching errors and panics; `done` sees each job as it ends, and the results come back in
 /// job order. `failed_before` runs already counted as failed (shown on the bar).
@@ -123,51 +162,28 @@ pub fn run_jobs<T: Send>(
     work: impl Fn(&Job) -> anyhow::Result<T> + Sync,
     ended: impl Fn(&Finished<T>) + Sync,
 ) -> anyhow::Result<Vec<Finished<T>>> {
-    if jobs.is_empty() {
-        return Ok(Vec::new());
-    }
-    let workers = worker_count(workers, jobs.len());
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(workers)
-        .thread_name(|i| format!("sim-batch-{i}"))
-        .build()
-        .map_err(|e| anyhow::anyhow!("--jobs {workers}: cannot start the workers: {e}"))?;
-    let next = AtomicUsize::new(0);
     let failed = AtomicUsize::new(failed_before);
-    let done: Mutex<Vec<Finished<T>>> = Mutex::new(Vec::with_capacity(jobs.len()));
-    pool.broadcast(|_| {
-        loop {
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            let Some(job) = jobs.get(i) else { break };
-            let started = Instant::now();
-            let result = match catch_unwind(AssertUnwindSafe(|| work(job))) {
-                Ok(Ok(v)) => Ok(v),
-                Ok(Err(e)) => Err(format!("{e:#}")),
-                Err(p) => Err(panic_text(p.as_ref())),
-            };
-            if let Err(e) = &result {
-                let n = failed.fetch_add(1, Ordering::Relaxed) + 1;
-                bar.set_message(format!("{n} failed"));
-                bar.suspend(|| eprintln!("{} failed: {e}", describe(job)));
-            }
-            bar.inc(1);
-            let f = Finished {
-                job: *job,
-                result,
-                wall_s: started.elapsed().as_secs_f64(),
-            };
-            ended(&f);
-            // a worker that panicked outside `work` cannot have poisoned this lock while holding it
-            if let Ok(mut d) = done.lock() {
-                d.push(f);
-            }
+    on_workers(jobs, workers, |_, job| {
+        let started = Instant::now();
+        let result = match catch_unwind(AssertUnwindSafe(|| work(job))) {
+            Ok(Ok(v)) => Ok(v),
+            Ok(Err(e)) => Err(format!("{e:#}")),
+            Err(p) => Err(panic_text(p.as_ref())),
+        };
+        if let Err(e) = &result {
+            let n = failed.fetch_add(1, Ordering::Relaxed) + 1;
+            bar.set_message(format!("{n} failed"));
+            bar.suspend(|| eprintln!("{} failed: {e}", describe(job)));
         }
-    });
-    let mut done = done
-        .into_inner()
-        .map_err(|_| anyhow::anyhow!("a batch worker failed"))?;
-    done.sort_by_key(|f| f.job.index);
-    Ok(done)
+        bar.inc(1);
+        let f = Finished {
+            job: *job,
+            result,
+            wall_s: started.elapsed().as_secs_f64(),
+        };
+        ended(&f);
+        f
+    })
 }
 
 #[cfg(test)]
@@ -280,5 +296,30 @@ mod tests {
                 Ok(50)
             ]
         );
+    }
+
+    /// A run whose kernels wait on a pool of their own keeps its worker to itself: no second
+    /// run is stacked on a worker while it waits (as a rayon `par_iter` over the runs does,
+    /// its waiting worker stealing the next run), so at most `workers` runs are in progress
+    /// at once; and the results come back in item order.
+    #[test]
+    fn a_worker_runs_one_item_at_a_time_however_its_kernels_wait() {
+        let active = AtomicUsize::new(0);
+        let most = AtomicUsize::new(0);
+        let items: Vec<usize> = (0..12).collect();
+        let out = on_workers(&items, 2, |i, &item| {
+            let now = active.fetch_add(1, Ordering::SeqCst) + 1;
+            most.fetch_max(now, Ordering::SeqCst);
+            let kernels = rayon::ThreadPoolBuilder::new()
+                .num_threads(1)
+                .build()
+                .unwrap();
+            kernels.install(|| std::thread::sleep(std::time::Duration::from_millis(20)));
+            active.fetch_sub(1, Ordering::SeqCst);
+            (i, item * 10)
+        })
+        .unwrap();
+        assert_eq!(out, (0..12).map(|i| (i, i * 10)).collect::<Vec<_>>());
+        assert_eq!(most.load(Ordering::SeqCst), 2);
     }
 }

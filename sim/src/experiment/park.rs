@@ -6,11 +6,11 @@
 //! single-threaded and deterministic, so the table does not depend on the thread count.
 
 use super::scan_pairs::bundled;
+use crate::batch::runner::on_workers;
 use crate::run::summary::road::RoadSummary;
 use crate::scenario::Scenario;
 use crate::scenario::outdoor_robot::RoadLocalizerKind;
 use crate::{RunOptions, run_scenario};
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// The routes of the experiment (bundled scenarios).
@@ -119,47 +119,40 @@ pub fn run_park_experiment(o: &ParkOptions) -> anyhow::Result<(Vec<ParkRow>, Vec
                 .flat_map(move |kind| (0..o.runs).map(move |seed| (s, kind, seed)))
         })
         .collect();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(o.threads)
-        .build()
-        .map_err(|e| anyhow::anyhow!("cannot start {} threads: {e}", o.threads))?;
     let done = std::sync::atomic::AtomicUsize::new(0);
     let total = jobs.len();
-    let runs: Vec<anyhow::Result<Vec<ParkRun>>> = pool.install(|| {
-        jobs.par_iter()
-            .map(|&(route, kind, seed)| {
-                let opts = RunOptions {
-                    rrd: None,
-                    threads: 1,
-                    progress: false,
-                    trajectory_period: None,
-                };
-                let out = run_scenario(&with_navigator(route, kind, seed), &opts)?;
-                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                if o.progress {
-                    eprintln!(
-                        "[{n}/{total}] {} by {} seed {seed}",
-                        route.name,
-                        kind.as_str()
-                    );
-                }
-                Ok(out
-                    .summary
-                    .robots
-                    .iter()
-                    .filter_map(|r| Some((r.name.clone(), r.road.clone()?)))
-                    .map(|(robot, road)| ParkRun {
-                        route: route.name.clone(),
-                        navigate_by: kind.as_str().to_string(),
-                        seed,
-                        robot,
-                        sim_time_s: out.summary.sim_time_s,
-                        road,
-                    })
-                    .collect())
-            })
-            .collect()
-    });
+    let runs = on_workers(&jobs, o.threads, |_, &(route, kind, seed)| {
+        let opts = RunOptions {
+            rrd: None,
+            threads: 1,
+            progress: false,
+            trajectory_period: None,
+        };
+        let out = run_scenario(&with_navigator(route, kind, seed), &opts)?;
+        let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if o.progress {
+            eprintln!(
+                "[{n}/{total}] {} by {} seed {seed}",
+                route.name,
+                kind.as_str()
+            );
+        }
+        anyhow::Ok(
+            out.summary
+                .robots
+                .iter()
+                .filter_map(|r| Some((r.name.clone(), r.road.clone()?)))
+                .map(|(robot, road)| ParkRun {
+                    route: route.name.clone(),
+                    navigate_by: kind.as_str().to_string(),
+                    seed,
+                    robot,
+                    sim_time_s: out.summary.sim_time_s,
+                    road,
+                })
+                .collect::<Vec<_>>(),
+        )
+    })?;
     let mut all = Vec::new();
     for r in runs {
         all.extend(r?);

@@ -9,6 +9,7 @@
 //! but the speed is independent of `--jobs`.
 
 use crate::batch::args::parse_seeds;
+use crate::batch::runner::{on_workers, worker_count};
 use crate::batch::sets::plan_sets;
 use crate::options::check_duration;
 use crate::scenario::Scenario;
@@ -16,7 +17,6 @@ use crate::scenario::load::scenario_path;
 use crate::scenario::source::Source;
 use crate::stats::median;
 use crate::{RunOptions, run_scenario};
-use rayon::prelude::*;
 use systems::eval::localization_metrics::CONVERGENCE_HOLD_S;
 use systems::eval::tracking::{LostEpisode, TrackingRecord, tracking_record};
 use systems::eval::trajectory;
@@ -142,34 +142,23 @@ fn one_run(scenario: &Scenario, seed: u64) -> anyhow::Result<(RunFacts, Vec<Loca
 /// Runs the experiment.
 pub fn run_localization_experiment(o: &LocalizationOptions) -> anyhow::Result<LocalizationResult> {
     let (scenario, seeds) = prepare(o)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(o.jobs)
-        .build()
-        .map_err(|e| anyhow::anyhow!("cannot start {} threads: {e}", o.jobs))?;
-    let jobs = pool.current_num_threads();
+    let jobs = worker_count(o.jobs, (seeds.end - seeds.start) as usize);
     let started = std::time::Instant::now();
     let done = std::sync::atomic::AtomicUsize::new(0);
     let total = (seeds.end - seeds.start) as usize;
     let seeds: Vec<u64> = seeds.collect();
-    let runs: Vec<anyhow::Result<(RunFacts, Vec<LocalizerRun>)>> = pool.install(|| {
-        seeds
-            .par_iter()
-            .map(|&seed| {
-                let r = one_run(&scenario, seed)
-                    .map_err(|e| anyhow::anyhow!("{} seed {seed}: {e}", scenario.name));
-                let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                if o.progress {
-                    match &r {
-                        Ok((f, _)) => {
-                            eprintln!("[{n}/{total}] seed {seed}: {} collisions", f.collisions)
-                        }
-                        Err(_) => eprintln!("[{n}/{total}] seed {seed}: failed"),
-                    }
-                }
-                r
-            })
-            .collect()
-    });
+    let runs = on_workers(&seeds, jobs, |_, &seed| {
+        let r = one_run(&scenario, seed)
+            .map_err(|e| anyhow::anyhow!("{} seed {seed}: {e}", scenario.name));
+        let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        if o.progress {
+            match &r {
+                Ok((f, _)) => eprintln!("[{n}/{total}] seed {seed}: {} collisions", f.collisions),
+                Err(_) => eprintln!("[{n}/{total}] seed {seed}: failed"),
+            }
+        }
+        r
+    })?;
     let mut facts = Vec::new();
     let mut per_run = Vec::new();
     for r in runs {

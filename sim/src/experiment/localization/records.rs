@@ -105,9 +105,8 @@ pub struct RunsRow {
     pub robot_collisions: u32,
     pub person_collisions: u32,
     /// Wall-clock time of all the runs (s), and the simulated time per run and wall second
-    /// with `jobs` runs at a time: Σ simulated / (wall × jobs). Runs share the worker
-    /// threads (a worker waiting inside one run may step another), so a run's own wall time
-    /// says nothing; this is the experiment's throughput per run.
+    /// with `jobs` runs at a time: Σ simulated / (wall × jobs), the experiment's throughput
+    /// per run, as `sim batch` reports it (each run has a worker to itself from start to end).
     pub wall_time_s: f64,
     pub real_time_factor_per_run: f64,
 }
